@@ -1,0 +1,46 @@
+# Every dependency is a Debian 12 package; tools/setup-deps.sh installs them.
+
+find_package(Eigen3 3.4 REQUIRED NO_MODULE)
+
+# LCM: prefer LCM's own CMake config (upstream installs ship it). Debian's
+# package ships only lcm.pc, which requires glib-2.0 without depending on its
+# -dev package, so pkg-config is never relied upon: fall back to the header
+# and library themselves.
+find_package(lcm CONFIG QUIET)
+if(TARGET lcm::lcm)
+  add_library(rtfuse_lcm INTERFACE)
+  target_link_libraries(rtfuse_lcm INTERFACE lcm::lcm)
+else()
+  find_path(LCM_INCLUDE_DIR lcm/lcm.h)
+  find_library(LCM_LIBRARY NAMES lcm)
+  if(NOT LCM_INCLUDE_DIR OR NOT LCM_LIBRARY)
+    message(FATAL_ERROR "LCM not found: install liblcm-dev (apt-get install liblcm-dev liblcm-bin)")
+  endif()
+  add_library(rtfuse_lcm INTERFACE)
+  target_include_directories(rtfuse_lcm SYSTEM INTERFACE ${LCM_INCLUDE_DIR})
+  target_link_libraries(rtfuse_lcm INTERFACE ${LCM_LIBRARY})
+endif()
+
+# lcm-gen and javac are host tools, also when cross-compiling.
+find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED)
+find_program(JAVAC_EXECUTABLE javac)
+find_program(JAR_EXECUTABLE jar)
+find_file(LCM_JAR lcm.jar PATHS /usr/share/java /usr/local/share/java NO_CMAKE_FIND_ROOT_PATH)
+
+# toml++ (header-only in use; the Debian package also ships a compiled lib)
+find_package(tomlplusplus QUIET)
+if(TARGET tomlplusplus::tomlplusplus)
+  add_library(rtfuse_toml INTERFACE)
+  target_link_libraries(rtfuse_toml INTERFACE tomlplusplus::tomlplusplus)
+else()
+  find_path(TOMLPP_INCLUDE_DIR toml++/toml.h REQUIRED)
+  add_library(rtfuse_toml INTERFACE)
+  target_include_directories(rtfuse_toml SYSTEM INTERFACE ${TOMLPP_INCLUDE_DIR})
+endif()
+
+find_package(CLI11 QUIET CONFIG)
+if(NOT TARGET CLI11::CLI11)
+  find_path(CLI11_INCLUDE_DIR CLI/CLI.hpp REQUIRED)
+  add_library(CLI11::CLI11 INTERFACE IMPORTED)
+  target_include_directories(CLI11::CLI11 INTERFACE ${CLI11_INCLUDE_DIR})
+endif()

@@ -1,0 +1,33 @@
+#pragma once
+// One clock in the process: CLOCK_MONOTONIC, int64 nanoseconds. LCM messages
+// carry utime in microseconds, so conversions live here and nowhere else.
+#include <cmath>
+#include <cstdint>
+#include <ctime>
+
+namespace rtfuse {
+
+using TimeNs = std::int64_t;
+
+constexpr TimeNs kNsPerSec = 1'000'000'000;
+constexpr TimeNs kNsPerUs = 1'000;
+
+inline TimeNs monotonic_now_ns() noexcept {
+  timespec ts{};
+  clock_gettime(CLOCK_MONOTONIC, &ts);
+  return static_cast<TimeNs>(ts.tv_sec) * kNsPerSec + ts.tv_nsec;
+}
+
+constexpr std::int64_t ns_to_utime(TimeNs t) noexcept { return t / kNsPerUs; }
+constexpr TimeNs utime_to_ns(std::int64_t utime) noexcept { return utime * kNsPerUs; }
+constexpr double ns_to_sec(TimeNs t) noexcept { return static_cast<double>(t) * 1e-9; }
+inline TimeNs sec_to_ns(double s) noexcept { return static_cast<TimeNs>(std::llround(s * 1e9)); }
+
+inline timespec ns_to_timespec(TimeNs t) noexcept {
+  timespec ts{};
+  ts.tv_sec = static_cast<time_t>(t / kNsPerSec);
+  ts.tv_nsec = static_cast<long>(t % kNsPerSec);
+  return ts;
+}
+
+}  // namespace rtfuse

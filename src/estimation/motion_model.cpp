@@ -1,0 +1,98 @@
+#include "estimation/motion_model.hpp"
+
+#include <cmath>
+
+namespace rtfuse::est {
+namespace {
+
+struct Trig {
+  double sr, cr, sp, cp, sy, cy;
+};
+
+Trig trig_of(const StateVector& x) noexcept {
+  return {std::sin(x(kRoll)), std::cos(x(kRoll)), std::sin(x(kPitch)),
+          std::cos(x(kPitch)), std::sin(x(kYaw)), std::cos(x(kYaw))};
+}
+
+// Body-to-world rotation, R = Rz(yaw) Ry(pitch) Rx(roll), as tf2.
+Eigen::Matrix3d body_to_world(const Trig& t) noexcept {
+  Eigen::Matrix3d r;
+  r << t.cy * t.cp, t.cy * t.sp * t.sr - t.sy * t.cr, t.cy * t.sp * t.cr + t.sy * t.sr,
+       t.sy * t.cp, t.sy * t.sp * t.sr + t.cy * t.cr, t.sy * t.sp * t.cr - t.cy * t.sr,
+       -t.sp,       t.cp * t.sr,                      t.cp * t.cr;
+  return r;
+}
+
+}  // namespace
+
+void motion_model_predict(StateVector& x, double dt) noexcept {
+  const Trig t = trig_of(x);
+  const Eigen::Matrix3d r = body_to_world(t);
+  const Eigen::Vector3d v = x.segment<3>(kVx);
+  const Eigen::Vector3d a = x.segment<3>(kAx);
+  const double tp = t.sp / t.cp;
+  const double vr = x(kVroll), vp = x(kVpitch), vy = x(kVyaw);
+
+  x.segment<3>(kX) += r * (v * dt + 0.5 * dt * dt * a);
+  // Body rates to Euler-angle rates (singular at pitch = ±pi/2, as in robot_localization).
+  x(kRoll) += (vr + t.sr * tp * vp + t.cr * tp * vy) * dt;
+  x(kPitch) += (t.cr * vp - t.sr * vy) * dt;
+  x(kYaw) += (t.sr / t.cp * vp + t.cr / t.cp * vy) * dt;
+  x.segment<3>(kVx) += a * dt;
+}
+
+MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept {
+  const Trig t = trig_of(x);
+  const Eigen::Matrix3d r = body_to_world(t);
+  const Eigen::Vector3d s = x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx);
+  const double vp = x(kVpitch), vy = x(kVyaw);
+  const double tp = t.sp / t.cp;
+  const double sec2 = 1.0 / (t.cp * t.cp);
+
+  // dR/droll, dR/dpitch, dR/dyaw applied to s.
+  Eigen::Matrix3d dr_droll, dr_dpitch, dr_dyaw;
+  dr_droll << 0, t.cy * t.sp * t.cr + t.sy * t.sr, -t.cy * t.sp * t.sr + t.sy * t.cr,
+              0, t.sy * t.sp * t.cr - t.cy * t.sr, -t.sy * t.sp * t.sr - t.cy * t.cr,
+              0, t.cp * t.cr,                      -t.cp * t.sr;
+  dr_dpitch << -t.cy * t.sp, t.cy * t.cp * t.sr, t.cy * t.cp * t.cr,
+               -t.sy * t.sp, t.sy * t.cp * t.sr, t.sy * t.cp * t.cr,
+               -t.cp,        -t.sp * t.sr,       -t.sp * t.cr;
+  dr_dyaw << -t.sy * t.cp, -t.sy * t.sp * t.sr - t.cy * t.cr, -t.sy * t.sp * t.cr + t.cy * t.sr,
+              t.cy * t.cp,  t.cy * t.sp * t.sr - t.sy * t.cr,  t.cy * t.sp * t.cr + t.sy * t.sr,
+              0,            0,                                  0;
+
+  MotionJacobian j;
+  j.pos_rpy.col(0) = dr_droll * s;
+  j.pos_rpy.col(1) = dr_dpitch * s;
+  j.pos_rpy.col(2) = dr_dyaw * s;
+  j.pos_vel = r * dt;
+  j.pos_acc = r * (0.5 * dt * dt);
+
+  j.rpy_rpy.setIdentity();
+  j.rpy_rpy(0, 0) += (t.cr * tp * vp - t.sr * tp * vy) * dt;
+  j.rpy_rpy(0, 1) = (t.sr * vp + t.cr * vy) * sec2 * dt;
+  j.rpy_rpy(1, 0) = (-t.sr * vp - t.cr * vy) * dt;
+  j.rpy_rpy(2, 0) = (t.cr * vp - t.sr * vy) / t.cp * dt;
+  j.rpy_rpy(2, 1) = (t.sr * vp + t.cr * vy) * t.sp * sec2 * dt;
+
+  j.rpy_rate << 1.0, t.sr * tp, t.cr * tp,
+                0.0, t.cr,      -t.sr,
+                0.0, t.sr / t.cp, t.cr / t.cp;
+  j.rpy_rate *= dt;
+  j.vel_acc = dt;
+  return j;
+}
+
+StateMatrix motion_model_jacobian_dense(const StateVector& x, double dt) noexcept {
+  const MotionJacobian j = motion_model_jacobian(x, dt);
+  StateMatrix f = StateMatrix::Identity();
+  f.block<3, 3>(kX, kRoll) = j.pos_rpy;
+  f.block<3, 3>(kX, kVx) = j.pos_vel;
+  f.block<3, 3>(kX, kAx) = j.pos_acc;
+  f.block<3, 3>(kRoll, kRoll) = j.rpy_rpy;
+  f.block<3, 3>(kRoll, kVroll) = j.rpy_rate;
+  f.block<3, 3>(kVx, kAx) = Eigen::Matrix3d::Identity() * j.vel_acc;
+  return f;
+}
+
+}  // namespace rtfuse::est

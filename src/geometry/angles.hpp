@@ -1,0 +1,19 @@
+#pragma once
+// Angle normalisation shared by the filter (yaw innovations) and config.
+#include <cmath>
+
+namespace rtfuse::geometry {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kTwoPi = 2.0 * kPi;
+
+// Wraps to [-pi, pi). std::remainder is exact for every finite input, so large
+// multiples of 2*pi keep their fractional part (a loop of += 2*pi would
+// accumulate rounding and never end for huge values; fmod + shift loses the
+// sign symmetry). Non-finite input gives NaN.
+inline double wrap_angle(double a) noexcept {
+  const double r = std::remainder(a, kTwoPi);  // in [-pi, pi]
+  return r >= kPi ? r - kTwoPi : r;
+}
+
+}  // namespace rtfuse::geometry

@@ -1,0 +1,95 @@
+#pragma once
+// The validated, fixed-size configuration. Parsed once from TOML before
+// start(); nothing is parsed afterwards. Schema: docs/configuration.md.
+#include <array>
+#include <cstdint>
+#include <string>
+#include <string_view>
+
+#include "core/fixed_string.hpp"
+#include "estimation/filter_params.hpp"
+#include "geometry/rigid_transform.hpp"
+
+namespace rtfuse {
+
+constexpr int kMaxSensors = 16;
+constexpr int kMaxStaticTransforms = 24;
+
+using Name = FixedString<63>;
+
+struct SensorConfig {
+  Name name;        // "odom0", "imu0", ... (robot_localization's sensor names)
+  Name channel;     // LCM channel (the ROS topic, unchanged)
+  est::SensorParams params;
+};
+
+struct StaticTransformConfig {
+  Name parent;
+  Name child;
+  geometry::RigidTransform parent_T_child;  // pose of child in parent
+};
+
+struct RealtimeConfig {
+  bool lock_memory = false;   // mlockall(MCL_CURRENT | MCL_FUTURE)
+  int priority = 0;           // SCHED_FIFO priority of the loop, 0 = leave SCHED_OTHER
+  int cpu = -1;               // pin the loop to this CPU, -1 = no affinity
+  bool require = false;       // exit instead of warning when the OS refuses
+};
+
+struct PublishConfig {
+  Name odometry_channel{"rtfuse/odometry"};
+  Name pose_channel{"rtfuse/pose"};
+  Name tf_channel{"rtfuse/tf"};
+  Name state_channel{"rtfuse/state"};
+  Name diagnostics_channel{"rtfuse/diagnostics"};
+  Name set_pose_channel{"rtfuse/set_pose"};
+  double odometry_rate_hz = 50.0;
+  double pose_rate_hz = 50.0;
+  double tf_rate_hz = 50.0;
+  double state_rate_hz = 10.0;
+  double diagnostics_rate_hz = 1.0;
+  bool publish_tf = true;
+};
+
+// The built-in simulated robot (config/sim.toml): a figure-eight drive with
+// ground truth, publishing imu_t and odometry_t on the sensors' channels.
+struct SimConfig {
+  bool enabled = false;
+  std::uint64_t seed = 1;
+  double figure_eight_radius_m = 3.0;
+  double speed_mps = 1.0;
+  double imu_rate_hz = 100.0;
+  double odom_rate_hz = 50.0;
+  Name imu_channel{"imu/data"};
+  Name odom_channel{"wheel/odom"};
+  Name truth_channel{"sim/ground_truth"};
+  double gyro_noise_rad_s = 0.005;
+  double gyro_bias_rad_s = 0.01;
+  double accel_noise_mps2 = 0.05;
+  double accel_bias_mps2 = 0.05;
+  double orientation_noise_rad = 0.01;
+  double yaw_drift_rad_s = 0.002;
+  double odom_speed_noise_mps = 0.02;
+  double odom_yaw_rate_noise_rad_s = 0.02;
+  double wheel_slip = 0.03;   // fractional speed error (scale), as on a real floor
+};
+
+struct RuntimeConfig {
+  std::string source;        // file the config came from ("<embedded sim.toml>" ...)
+  double rate_hz = 200.0;    // [filter] frequency
+  Name world_frame{"odom"};
+  Name odom_frame{"odom"};
+  Name base_link_frame{"base_link"};
+  Name map_frame{"map"};
+  est::FilterParams filter;
+  std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  RealtimeConfig realtime;
+  PublishConfig publish;
+  std::array<SensorConfig, kMaxSensors> sensors{};
+  int num_sensors = 0;
+  std::array<StaticTransformConfig, kMaxStaticTransforms> static_transforms{};
+  int num_static_transforms = 0;
+  SimConfig sim;
+};
+
+}  // namespace rtfuse

@@ -1,0 +1,57 @@
+#pragma once
+// The loop's work for one tick, free of threads and clocks so the daemon and
+// the replay run exactly the same code: drain the rings (bounded), order by
+// stamp, preprocess and fuse, then publish a snapshot through the seqlock.
+#include <memory>
+
+#include "core/seqlock.hpp"
+#include "estimation/filter.hpp"
+#include "estimation/sensor_model.hpp"
+#include "geometry/frame_tree.hpp"
+#include "runtime/config.hpp"
+#include "runtime/input_router.hpp"
+#include "runtime/snapshot.hpp"
+
+namespace rtfuse {
+
+class FusionCore {
+ public:
+  // Builds the frame tree from the static transforms; *error on a bad tree.
+  static std::unique_ptr<FusionCore> create(const RuntimeConfig& cfg, std::string* error);
+
+  InputRouter& input() { return *input_; }
+  const geometry::FrameTree& frames() const { return frames_; }
+  const RuntimeConfig& config() const { return cfg_; }
+
+  // One loop iteration at loop time `now`. Never allocates, locks or blocks.
+  void tick(TimeNs now, const LoopStats& loop) noexcept;
+  const SeqLock<Snapshot>& snapshot() const { return snapshot_; }
+  const est::Filter& filter() const { return *filter_; }
+
+ private:
+  explicit FusionCore(const RuntimeConfig& cfg);
+  bool build_frames(std::string* error);
+  void apply_set_pose(const SetPoseCommand& cmd) noexcept;
+  void fuse(const est::SensorSample& s, TimeNs now) noexcept;
+  void publish_snapshot(TimeNs now, const LoopStats& loop) noexcept;
+
+  RuntimeConfig cfg_;
+  geometry::FrameTree frames_;
+  est::FusionFrames fusion_frames_;
+  std::unique_ptr<InputRouter> input_;
+  std::unique_ptr<est::Filter> filter_;
+  est::SensorModel models_[kMaxSensors];
+  SensorStats stats_[kMaxSensors];
+  TimeNs last_arrival_[kMaxSensors] = {};
+  std::unique_ptr<est::SensorSample[]> staging_;
+  int staging_capacity_ = 0;
+  std::int64_t set_pose_count_ = 0;
+  std::int64_t set_pose_rejected_ = 0;
+  std::int64_t fused_total_ = 0;
+  std::int64_t lagged_replays_ = 0;
+  std::uint64_t seq_ = 0;
+  Snapshot scratch_;
+  SeqLock<Snapshot> snapshot_;
+};
+
+}  // namespace rtfuse

@@ -1,0 +1,43 @@
+#include "runtime/input_router.hpp"
+
+#include <cstring>
+
+namespace rtfuse {
+
+InputRouter::InputRouter(const RuntimeConfig& cfg, const geometry::FrameTree& frames)
+    : cfg_(cfg), num_sensors_(cfg.num_sensors), decoder_(frames) {
+  for (int i = 0; i < num_sensors_; ++i) {
+    // Twice the robot_localization queue: one tick drains queue_size, the
+    // rest absorbs a producer burst while the loop is mid-tick.
+    rings_[i] = std::make_unique<SpscRing<est::SensorSample>>(
+        static_cast<std::size_t>(2 * cfg.sensors[i].params.queue_size));
+  }
+}
+
+bool InputRouter::on_message(const char* channel, const std::uint8_t* data, int size) noexcept {
+  for (int i = 0; i < num_sensors_; ++i) {
+    if (std::strcmp(cfg_.sensors[i].channel.c_str(), channel) != 0) continue;
+    InputCounters& c = counters_[i];
+    c.received.fetch_add(1, std::memory_order_relaxed);
+    if (decoder_.decode(cfg_.sensors[i].params.kind, data, size, &scratch_) != transport::DecodeResult::kOk) {
+      c.decode_errors.fetch_add(1, std::memory_order_relaxed);
+      return true;
+    }
+    scratch_.sensor = static_cast<std::uint8_t>(i);
+    if (!rings_[i]->try_push(scratch_)) c.overflow.fetch_add(1, std::memory_order_relaxed);
+    return true;
+  }
+  if (std::strcmp(cfg_.publish.set_pose_channel.c_str(), channel) == 0) {
+    SetPoseCommand cmd;
+    if (decoder_.decode_set_pose(data, size, &cmd.pose, &cmd.stamp, &cmd.frame) != transport::DecodeResult::kOk) {
+      set_pose_errors_.fetch_add(1, std::memory_order_relaxed);
+      return true;
+    }
+    set_pose_ring_.try_push(cmd);
+    return true;
+  }
+  unknown_.fetch_add(1, std::memory_order_relaxed);
+  return false;
+}
+
+}  // namespace rtfuse

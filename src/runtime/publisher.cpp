@@ -1,0 +1,282 @@
+#include "runtime/publisher.hpp"
+
+#include <array>
+#include <cmath>
+#include <vector>
+
+#include "geometry/rotation.hpp"
+#include "rtfuse/diagnostics_t.hpp"
+#include "rtfuse/filter_state_t.hpp"
+#include "rtfuse/odometry_t.hpp"
+#include "rtfuse/pose_with_covariance_stamped_t.hpp"
+#include "rtfuse/tf_t.hpp"
+#include "transport/encode_buffer.hpp"
+
+namespace rtfuse {
+namespace {
+
+constexpr int kN = 15;        // states
+constexpr int kMargin = 64;   // bytes beyond getEncodedSize(): sizes are fixed, this is belt and braces
+
+// Fixed-rate schedule on the caller's clock. The next slot advances by whole
+// periods from the previous slot, not from `now`, so a 30 Hz output polled at
+// 1 kHz averages 30 Hz instead of drifting down to 1/ceil(period).
+class Schedule {
+ public:
+  void set_rate(double rate_hz) {
+    period_ = 0;
+    if (std::isfinite(rate_hz) && rate_hz > 0.0) {
+      const TimeNs p = sec_to_ns(1.0 / rate_hz);
+      period_ = p > 0 ? p : 1;
+    }
+  }
+  bool enabled() const noexcept { return period_ > 0; }
+
+  // True (and the slot consumed) when a message is due at now.
+  bool due(TimeNs now) noexcept {
+    if (!enabled()) return false;
+    // First call, or the clock went back (a replay restarted): publish now.
+    if (!started_ || now < next_ - period_) {
+      started_ = true;
+      next_ = now + period_;
+      return true;
+    }
+    if (now < next_) return false;
+    next_ += period_;
+    // After a stall, skip the missed slots rather than send a burst.
+    if (now >= next_) next_ = now + period_;
+    return true;
+  }
+
+ private:
+  TimeNs period_ = 0;  // 0: disabled
+  TimeNs next_ = 0;
+  bool started_ = false;
+};
+
+template <class Msg>
+struct Output {
+  Msg msg{};
+  std::vector<std::uint8_t> bytes;
+  Schedule schedule;
+  const char* channel = "";
+  std::uint32_t seq = 0;  // unsigned: wraps instead of overflowing after years
+
+  // Called once the strings and array sizes are final. Encoding once here
+  // also runs lcm-gen's lazily computed static hashes off the hot path.
+  void finalize() {
+    bytes.assign(static_cast<std::size_t>(msg.getEncodedSize() + kMargin), 0);
+    msg.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  }
+  std::int32_t next_seq() noexcept { return static_cast<std::int32_t>(seq++); }
+};
+
+double cov(const Snapshot& s, int row, int col) noexcept { return s.covariance[row * kN + col]; }
+
+void fill_pose(const Snapshot& s, rtfuse::pose_with_covariance_t& p) noexcept {
+  p.pose.position.x = s.state[0];
+  p.pose.position.y = s.state[1];
+  p.pose.position.z = s.state[2];
+  const Eigen::Quaterniond q = geometry::quaternion_from_rpy(s.state[3], s.state[4], s.state[5]);
+  p.pose.orientation.x = q.x();
+  p.pose.orientation.y = q.y();
+  p.pose.orientation.z = q.z();
+  p.pose.orientation.w = q.w();
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) p.covariance[r * 6 + c] = cov(s, r, c);
+}
+
+void fill_twist(const Snapshot& s, rtfuse::twist_with_covariance_t& t) noexcept {
+  t.twist.linear.x = s.state[6];
+  t.twist.linear.y = s.state[7];
+  t.twist.linear.z = s.state[8];
+  t.twist.angular.x = s.state[9];
+  t.twist.angular.y = s.state[10];
+  t.twist.angular.z = s.state[11];
+  for (int r = 0; r < 6; ++r)
+    for (int c = 0; c < 6; ++c) t.covariance[r * 6 + c] = cov(s, 6 + r, 6 + c);
+}
+
+std::int64_t rejections(const SensorStats& st) noexcept {
+  return st.rejected_mahalanobis + st.rejected_invalid + st.rejected_stale + st.rejected_overflow +
+         st.decode_errors;
+}
+
+}  // namespace
+
+struct Publisher::Impl {
+  explicit Impl(const RuntimeConfig& c) : cfg(c.publish) {}
+
+  template <class Msg>
+  int emit(Output<Msg>& out, TimeNs now, MessageSink& sink) noexcept {
+    const int n = transport::encode_into(out.msg, out.bytes.data(), static_cast<int>(out.bytes.size()));
+    if (n < 0) {
+      ++encode_failures;
+      return 0;
+    }
+    return sink.publish(out.channel, out.bytes.data(), n, now) ? 1 : 0;
+  }
+
+  PublishConfig cfg;  // owns the channel strings the outputs point into
+  int num_sensors = 0;
+  Output<rtfuse::odometry_t> odometry;
+  Output<rtfuse::pose_with_covariance_stamped_t> pose;
+  Output<rtfuse::tf_t> tf;
+  Output<rtfuse::filter_state_t> state;
+  Output<rtfuse::diagnostics_t> diagnostics;
+  std::array<std::int64_t, kMaxSensors> rejections_at_last_diagnostics{};
+  std::int64_t encode_failures = 0;
+};
+
+Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) {
+  Impl& m = *impl_;
+  const std::string world = c.world_frame.c_str();
+  const std::string base = c.base_link_frame.c_str();
+
+  m.odometry.channel = m.cfg.odometry_channel.c_str();
+  m.odometry.schedule.set_rate(m.cfg.odometry_rate_hz);
+  m.odometry.msg.header.frame_id = world;
+  m.odometry.msg.child_frame_id = base;
+  m.odometry.finalize();
+
+  m.pose.channel = m.cfg.pose_channel.c_str();
+  m.pose.schedule.set_rate(m.cfg.pose_rate_hz);
+  m.pose.msg.header.frame_id = world;
+  m.pose.finalize();
+
+  m.tf.channel = m.cfg.tf_channel.c_str();
+  m.tf.schedule.set_rate(m.cfg.publish_tf ? m.cfg.tf_rate_hz : 0.0);
+  m.tf.msg.num_transforms = 1;
+  m.tf.msg.transforms.resize(1);
+  m.tf.msg.transforms[0].header.frame_id = world;
+  m.tf.msg.transforms[0].child_frame_id = base;
+  m.tf.msg.transforms[0].transform.rotation.w = 1.0;
+  m.tf.finalize();
+
+  m.state.channel = m.cfg.state_channel.c_str();
+  m.state.schedule.set_rate(m.cfg.state_rate_hz);
+  m.state.msg.header.frame_id = world;
+  m.state.msg.child_frame_id = base;
+  m.state.finalize();
+
+  m.diagnostics.channel = m.cfg.diagnostics_channel.c_str();
+  m.diagnostics.schedule.set_rate(m.cfg.diagnostics_rate_hz);
+  const int n = c.num_sensors < 0 ? 0 : (c.num_sensors > kMaxSensors ? kMaxSensors : c.num_sensors);
+  m.num_sensors = n;
+  m.diagnostics.msg.num_sensors = n;
+  m.diagnostics.msg.sensors.resize(static_cast<std::size_t>(n));
+  for (int i = 0; i < n; ++i) {
+    auto& st = m.diagnostics.msg.sensors[static_cast<std::size_t>(i)];
+    st.name = c.sensors[static_cast<std::size_t>(i)].name.c_str();
+    st.channel = c.sensors[static_cast<std::size_t>(i)].channel.c_str();
+    st.level = rtfuse::sensor_status_t::STALE;
+  }
+  m.diagnostics.finalize();
+}
+
+Publisher::~Publisher() = default;
+
+std::int64_t Publisher::encode_failures() const { return impl_->encode_failures; }
+
+int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
+  Impl& m = *impl_;
+  int sent = 0;
+  // The estimate's own time, not the publishing time: consumers interpolate
+  // and look up transforms by it, as they would with robot_localization.
+  const std::int64_t utime = ns_to_utime(s.stamp_ns);
+
+  if (s.initialized && m.odometry.schedule.due(now)) {
+    auto& o = m.odometry.msg;
+    o.header.utime = utime;
+    o.header.seq = m.odometry.next_seq();
+    fill_pose(s, o.pose);
+    fill_twist(s, o.twist);
+    sent += m.emit(m.odometry, now, sink);
+  }
+
+  if (s.initialized && m.pose.schedule.due(now)) {
+    auto& o = m.pose.msg;
+    o.header.utime = utime;
+    o.header.seq = m.pose.next_seq();
+    fill_pose(s, o.pose);
+    sent += m.emit(m.pose, now, sink);
+  }
+
+  if (s.initialized && m.tf.schedule.due(now)) {
+    auto& t = m.tf.msg.transforms[0];
+    t.header.utime = utime;
+    t.header.seq = m.tf.next_seq();
+    t.transform.translation.x = s.state[0];
+    t.transform.translation.y = s.state[1];
+    t.transform.translation.z = s.state[2];
+    const Eigen::Quaterniond q = geometry::quaternion_from_rpy(s.state[3], s.state[4], s.state[5]);
+    t.transform.rotation.x = q.x();
+    t.transform.rotation.y = q.y();
+    t.transform.rotation.z = q.z();
+    t.transform.rotation.w = q.w();
+    sent += m.emit(m.tf, now, sink);
+  }
+
+  if (s.initialized && m.state.schedule.due(now)) {
+    auto& o = m.state.msg;
+    o.header.utime = utime;
+    o.header.seq = m.state.next_seq();
+    o.initialized = s.initialized;
+    for (int i = 0; i < kN; ++i) o.state[i] = s.state[i];
+    for (int i = 0; i < kN * kN; ++i) o.covariance[i] = s.covariance[i];
+    sent += m.emit(m.state, now, sink);
+  }
+
+  if (m.diagnostics.schedule.due(now)) {
+    auto& d = m.diagnostics.msg;
+    // Diagnostics describe the process now, not the estimate.
+    d.header.utime = ns_to_utime(now);
+    d.header.seq = m.diagnostics.next_seq();
+    d.loop.rate_hz = s.loop.rate_hz;
+    d.loop.period_ns = s.loop.period_ns;
+    d.loop.ticks = s.loop.ticks;
+    d.loop.overruns = s.loop.overruns;
+    d.loop.jitter_mean_ns = s.loop.jitter_mean_ns;
+    d.loop.jitter_max_ns = s.loop.jitter_max_ns;
+    d.loop.tick_duration_mean_ns = s.loop.tick_duration_mean_ns;
+    d.loop.tick_duration_max_ns = s.loop.tick_duration_max_ns;
+    d.loop.measurements_fused = s.loop.measurements_fused;
+    d.loop.lagged_replays = s.loop.lagged_replays;
+    d.unknown_channel_messages = s.unknown_channel_messages;
+    d.set_pose_count = s.set_pose_count;
+    for (int i = 0; i < m.num_sensors; ++i) {
+      const SensorStats& in = s.sensors[i];
+      auto& out = d.sensors[static_cast<std::size_t>(i)];
+      out.last_stamp_utime = ns_to_utime(in.last_stamp_ns);
+      out.rate_hz = in.rate_hz;
+      out.received = in.received;
+      out.accepted = in.accepted;
+      out.rejected_mahalanobis = in.rejected_mahalanobis;
+      out.rejected_invalid = in.rejected_invalid;
+      out.rejected_stale = in.rejected_stale;
+      out.rejected_overflow = in.rejected_overflow;
+      out.decode_errors = in.decode_errors;
+      out.yaw_conflicts = in.yaw_conflicts;
+      out.timeouts = in.timeouts;
+      out.timed_out = in.timed_out;
+      // WARN compares with the previous message so that one bad burst does
+      // not keep a sensor yellow for the rest of the run.
+      const std::int64_t rejected = rejections(in);
+      auto& previous = m.rejections_at_last_diagnostics[static_cast<std::size_t>(i)];
+      if (in.received == 0) {
+        out.level = rtfuse::sensor_status_t::STALE;
+      } else if (in.timed_out) {
+        out.level = rtfuse::sensor_status_t::ERROR;
+      } else if (rejected != previous) {
+        out.level = rtfuse::sensor_status_t::WARN;
+      } else {
+        out.level = rtfuse::sensor_status_t::OK;
+      }
+      previous = rejected;
+    }
+    sent += m.emit(m.diagnostics, now, sink);
+  }
+  return sent;
+}
+
+}  // namespace rtfuse

@@ -1,0 +1,46 @@
+#pragma once
+// Turns the loop's Snapshot into the LCM outputs (odometry, pose, tf, full
+// filter state, diagnostics) at their configured rates.
+//
+// Everything that allocates happens in the constructor: one generated message
+// object per output with its strings already set, and one byte buffer each.
+// poll() only overwrites numbers, encodes into those buffers and hands the
+// bytes to a MessageSink (lcm_publish from the caller's buffer in the daemon,
+// a capture in tests), so it may run on any thread that must not allocate.
+#include <cstdint>
+#include <memory>
+
+#include "core/time.hpp"
+#include "runtime/config.hpp"
+#include "runtime/snapshot.hpp"
+
+namespace rtfuse {
+
+class MessageSink {
+ public:
+  virtual ~MessageSink() = default;
+  // The bytes are valid only during the call. False: the message was lost.
+  virtual bool publish(const char* channel, const std::uint8_t* data, int size, TimeNs now) = 0;
+};
+
+class Publisher {
+ public:
+  explicit Publisher(const RuntimeConfig& cfg);
+  ~Publisher();
+  Publisher(const Publisher&) = delete;
+  Publisher& operator=(const Publisher&) = delete;
+
+  // Publishes every enabled output that is due at `now` (all of them on the
+  // first call); returns how many messages the sink accepted. State outputs
+  // wait for s.initialized; diagnostics do not.
+  int poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept;
+
+  // Messages that did not fit their buffer (never expected: sizes are fixed).
+  std::int64_t encode_failures() const;
+
+ private:
+  struct Impl;  // the lcm-gen types stay out of this header
+  std::unique_ptr<Impl> impl_;
+};
+
+}  // namespace rtfuse

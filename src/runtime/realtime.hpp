@@ -1,0 +1,22 @@
+#pragma once
+// Real-time settings the OS may refuse (EPERM without CAP_SYS_NICE /
+// CAP_IPC_LOCK): reported once, fatal only when the config demands them.
+#include <string>
+
+#include "runtime/config.hpp"
+
+namespace rtfuse {
+
+struct RealtimeOutcome {
+  bool ok = true;          // every requested setting applied
+  std::string warnings;    // one line per refused setting, with errno text and the fix
+};
+
+// Process-wide: mlockall. Call once before threads start.
+RealtimeOutcome apply_memory_lock(const RealtimeConfig& rt);
+// For the calling thread: SCHED_FIFO priority and CPU affinity.
+RealtimeOutcome apply_thread_realtime(const RealtimeConfig& rt);
+// Names the calling thread (15 chars max) for top -H and debuggers.
+void name_this_thread(const char* name);
+
+}  // namespace rtfuse

@@ -1,0 +1,130 @@
+#include "runtime/runtime.hpp"
+
+#include <algorithm>
+#include <atomic>
+
+#include "runtime/lcm_sink.hpp"
+#include "runtime/loop_timer.hpp"
+#include "runtime/realtime.hpp"
+
+namespace rtfuse {
+
+std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, std::string* error) {
+  std::unique_ptr<Runtime> rt(new Runtime());
+  rt->core_ = FusionCore::create(cfg, error);
+  if (!rt->core_) return nullptr;
+  rt->publisher_ = std::make_unique<Publisher>(rt->core_->config());
+  rt->lcm_ = transport::LcmNode::create(cfg.lcm_url, error);
+  if (!rt->lcm_) return nullptr;
+  const RuntimeConfig& c = rt->core_->config();
+  for (int i = 0; i < c.num_sensors; ++i) {
+    if (!rt->lcm_->subscribe(c.sensors[i].channel.c_str(), &Runtime::on_lcm, rt->core_.get())) {
+      *error = "cannot subscribe to channel '" + std::string(c.sensors[i].channel.view()) + "'";
+      return nullptr;
+    }
+  }
+  if (!rt->lcm_->subscribe(c.publish.set_pose_channel.c_str(), &Runtime::on_lcm, rt->core_.get())) {
+    *error = "cannot subscribe to the set_pose channel";
+    return nullptr;
+  }
+  return rt;
+}
+
+Runtime::~Runtime() { stop(); }
+
+void Runtime::on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user) {
+  static_cast<FusionCore*>(user)->input().on_message(channel, data, size);
+}
+
+bool Runtime::start(std::string* error, std::string* warnings) {
+  const RealtimeConfig& rtc = core_->config().realtime;
+  const RealtimeOutcome mem = apply_memory_lock(rtc);
+  if (!mem.ok) {
+    if (rtc.require) {
+      *error = mem.warnings + "realtime.require = true: refusing to run without it";
+      return false;
+    }
+    *warnings += mem.warnings;
+  }
+  running_.store(true);
+  // The loop thread applies its own scheduling; start() waits for its verdict
+  // so a required-but-refused setting stops the process before it runs.
+  loop_ = std::thread(&Runtime::loop_thread, this);
+  while (!steady_.load(std::memory_order_acquire) && !rt_failed_.load(std::memory_order_acquire)) {
+    std::this_thread::yield();
+  }
+  if (rt_failed_.load()) {
+    if (rtc.require) {
+      running_.store(false);
+      loop_.join();
+      *error = rt_warnings_ + "realtime.require = true: refusing to run without it";
+      return false;
+    }
+    *warnings += rt_warnings_;
+  }
+  pub_ = std::thread(&Runtime::publisher_thread, this);
+  lcmin_ = std::thread(&Runtime::input_thread, this);
+  return true;
+}
+
+void Runtime::stop() {
+  if (!running_.exchange(false)) return;
+  if (loop_.joinable()) loop_.join();
+  if (pub_.joinable()) pub_.join();
+  if (lcmin_.joinable()) lcmin_.join();
+}
+
+Snapshot Runtime::latest() const {
+  Snapshot s;
+  core_->snapshot().load(s);
+  return s;
+}
+
+void Runtime::loop_thread() {
+  name_this_thread("rtfuse-loop");
+  const RealtimeOutcome r = apply_thread_realtime(core_->config().realtime);
+  if (!r.ok) {
+    rt_warnings_ = r.warnings;
+    rt_failed_.store(true, std::memory_order_release);
+    if (core_->config().realtime.require) return;
+  }
+  LoopTimer timer(core_->config().rate_hz, monotonic_now_ns());
+  // One tick before declaring steady state, so first-touch effects are over.
+  core_->tick(monotonic_now_ns(), timer.stats());
+  steady_.store(true, std::memory_order_release);
+  while (running_.load(std::memory_order_relaxed)) {
+    sleep_until(timer.deadline());
+    const TimeNs woke = monotonic_now_ns();
+    core_->tick(woke, timer.stats());
+    timer.record(woke, monotonic_now_ns());
+  }
+}
+
+void Runtime::publisher_thread() {
+  name_this_thread("rtfuse-pub");
+  LcmSink sink(*lcm_);
+  const PublishConfig& p = core_->config().publish;
+  const double fastest = std::max({p.odometry_rate_hz, p.pose_rate_hz, p.tf_rate_hz, p.state_rate_hz,
+                                   p.diagnostics_rate_hz, 1.0});
+  // Wake at twice the fastest output rate (at most 1 kHz) so no output is
+  // late by more than half its period.
+  const TimeNs period = std::max<TimeNs>(sec_to_ns(0.5 / fastest), 1'000'000);
+  Snapshot snap;
+  TimeNs next = monotonic_now_ns();
+  while (running_.load(std::memory_order_relaxed)) {
+    next += period;
+    sleep_until(next);
+    core_->snapshot().load(snap);
+    publisher_->poll(snap, monotonic_now_ns(), sink);
+  }
+}
+
+void Runtime::input_thread() {
+  name_this_thread("rtfuse-lcmin");
+  while (running_.load(std::memory_order_relaxed)) {
+    // Bounded wait so a stop request is seen within 50 ms.
+    lcm_->handle_timeout(50);
+  }
+}
+
+}  // namespace rtfuse

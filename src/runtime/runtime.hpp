@@ -1,0 +1,52 @@
+#pragma once
+// The live runtime: the fixed-rate loop thread (rtfuse-loop), the publisher
+// thread (rtfuse-pub) and the LCM input thread (rtfuse-lcmin) around one
+// FusionCore. Everything is allocated in create(); the threads allocate
+// nothing once running.
+#include <atomic>
+#include <memory>
+#include <string>
+#include <thread>
+
+#include "runtime/fusion_core.hpp"
+#include "runtime/publisher.hpp"
+#include "transport/lcm_node.hpp"
+
+namespace rtfuse {
+
+class Runtime {
+ public:
+  static std::unique_ptr<Runtime> create(const RuntimeConfig& cfg, std::string* error);
+  ~Runtime();
+
+  // Applies the real-time settings and starts the threads. Returns false (and
+  // *error) when a required setting is refused or a thread cannot start;
+  // refused optional settings are written to *warnings.
+  bool start(std::string* error, std::string* warnings);
+  void stop();
+
+  Snapshot latest() const;
+  transport::LcmNode& lcm() { return *lcm_; }
+  const RuntimeConfig& config() const { return core_->config(); }
+  // Set by the loop after its first steady tick; tests and tools use it to
+  // know when start-up allocations are over.
+  bool steady() const { return steady_.load(std::memory_order_acquire); }
+
+ private:
+  Runtime() = default;
+  void loop_thread();
+  void publisher_thread();
+  void input_thread();
+  static void on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
+
+  std::unique_ptr<FusionCore> core_;
+  std::unique_ptr<Publisher> publisher_;
+  std::unique_ptr<transport::LcmNode> lcm_;
+  std::atomic<bool> running_{false};
+  std::atomic<bool> steady_{false};
+  std::atomic<bool> rt_failed_{false};
+  std::string rt_warnings_;
+  std::thread loop_, pub_, lcmin_;
+};
+
+}  // namespace rtfuse

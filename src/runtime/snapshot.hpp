@@ -1,0 +1,53 @@
+#pragma once
+// What the loop publishes to the rest of the process after every tick, through
+// a SeqLock: plain arrays only, so it is trivially copyable.
+#include <cstdint>
+
+#include "runtime/config.hpp"
+
+namespace rtfuse {
+
+struct SensorStats {
+  std::int64_t last_stamp_ns = 0;
+  double rate_hz = 0.0;
+  std::int64_t received = 0;
+  std::int64_t accepted = 0;
+  std::int64_t rejected_mahalanobis = 0;
+  std::int64_t rejected_invalid = 0;   // NaN/Inf, bad covariance, no transform, out of order
+  std::int64_t rejected_stale = 0;     // older than the history
+  std::int64_t rejected_overflow = 0;  // ring full: the loop fell behind
+  std::int64_t decode_errors = 0;
+  std::int64_t yaw_conflicts = 0;
+  std::int64_t timeouts = 0;
+  bool timed_out = false;
+};
+
+struct LoopStats {
+  double rate_hz = 0.0;
+  std::int64_t period_ns = 0;
+  std::int64_t ticks = 0;
+  std::int64_t overruns = 0;
+  std::int64_t jitter_mean_ns = 0;
+  std::int64_t jitter_max_ns = 0;
+  std::int64_t tick_duration_mean_ns = 0;
+  std::int64_t tick_duration_max_ns = 0;
+  std::int64_t measurements_fused = 0;
+  std::int64_t lagged_replays = 0;
+};
+
+struct Snapshot {
+  std::int64_t tick_time_ns = 0;   // loop clock when the snapshot was taken
+  std::int64_t stamp_ns = 0;       // time the estimate is valid at (last measurement)
+  std::uint64_t seq = 0;
+  bool initialized = false;
+  double state[15] = {};
+  double covariance[225] = {};     // row-major
+  LoopStats loop;
+  std::int64_t unknown_channel_messages = 0;
+  std::int64_t set_pose_count = 0;
+  std::int64_t set_pose_rejected = 0;  // frame not connected to the world frame
+  int num_sensors = 0;
+  SensorStats sensors[kMaxSensors];
+};
+
+}  // namespace rtfuse

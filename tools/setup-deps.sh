@@ -1,0 +1,36 @@
+#!/usr/bin/env bash
+# Installs the Debian 12 packages rtfuse builds, tests and runs with, skipping
+# what is already there (so a set-up machine does no apt work at all).
+set -euo pipefail
+
+packages=(
+  g++ cmake ninja-build make
+  libeigen3-dev
+  liblcm-dev liblcm-bin liblcm-java
+  libtomlplusplus-dev libcli11-dev
+  libgtest-dev libgmock-dev libbenchmark-dev
+  default-jdk-headless
+  python3 python3-rosbag python3-yaml
+  iproute2 util-linux
+  linux-libc-dev
+)
+
+missing=()
+for p in "${packages[@]}"; do
+  status=$(dpkg-query -W -f='${Status}' "$p" 2>/dev/null || true)
+  [[ "$status" == "install ok installed" ]] || missing+=("$p")
+done
+
+if ((${#missing[@]} == 0)); then
+  exit 0
+fi
+
+echo "rtfuse: installing missing packages: ${missing[*]}"
+if [[ $(id -u) -ne 0 ]]; then
+  SUDO=sudo
+else
+  SUDO=
+fi
+export DEBIAN_FRONTEND=noninteractive
+$SUDO apt-get update -qq
+$SUDO apt-get install -y -qq --no-install-recommends "${missing[@]}"
