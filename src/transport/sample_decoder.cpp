@@ -1,6 +1,8 @@
 #include "transport/sample_decoder.hpp"
 
 #include <algorithm>
+
+#include <Eigen/Eigenvalues>
 #include <cmath>
 #include <exception>
 #include <initializer_list>
@@ -90,6 +92,17 @@ DecodeResult check_covariance(const double (&c)[N * N]) {
       if (std::abs(c[r * N + k] - c[k * N + r]) > kSymmetryTolerance * scale) {
         return DecodeResult::kBadCovariance;
       }
+    }
+  }
+  // Symmetric with a non-negative diagonal can still describe a negative
+  // variance along some direction, which would let the filter's covariance go
+  // indefinite. A fixed-size eigen solve does not allocate and runs on the
+  // input thread, not the loop.
+  if (scale > 0.0) {
+    const Eigen::Map<const Eigen::Matrix<double, N, N, Eigen::RowMajor>> m(c);
+    const Eigen::SelfAdjointEigenSolver<Eigen::Matrix<double, N, N>> es(m, Eigen::EigenvaluesOnly);
+    if (es.info() != Eigen::Success || es.eigenvalues().minCoeff() < -1e-9 * scale) {
+      return DecodeResult::kBadCovariance;
     }
   }
   return DecodeResult::kOk;

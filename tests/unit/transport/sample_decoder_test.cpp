@@ -129,6 +129,7 @@ TEST_F(SampleDecoderTest, OdometryValuesAndCovariances) {
 
 TEST_F(SampleDecoderTest, RowMajorCovarianceIsNotTransposed) {
   auto m = good_twist();
+  m.twist.covariance[0 * 6 + 0] = 1.0;  // keep the matrix positive definite
   // Symmetric within tolerance but the two halves are told apart by their last digit.
   m.twist.covariance[0 * 6 + 5] = 0.123456789;
   m.twist.covariance[5 * 6 + 0] = 0.1234567891;
@@ -243,9 +244,19 @@ TEST_F(SampleDecoderTest, BadCovariances) {
   // Relative tolerance: a 1e-9 mismatch on entries of 1e6 is rounding, not asymmetry.
   p = good_pose();
   p.pose.covariance[0] = 1e6;
+  p.pose.covariance[14] = 1e6;
   p.pose.covariance[2] = 5e5;
   p.pose.covariance[12] = 5e5 + 1e-3;
   EXPECT_EQ(decode(SensorKind::kPose, p), DecodeResult::kOk);
+
+  // Symmetric, non-negative diagonal, yet indefinite: a correlation above 1
+  // between x and y (eigenvalues of [[1,2],[2,1]] are 3 and -1).
+  p = good_pose();
+  p.pose.covariance[0] = 1.0;
+  p.pose.covariance[7] = 1.0;
+  p.pose.covariance[1] = 2.0;
+  p.pose.covariance[6] = 2.0;
+  EXPECT_EQ(decode(SensorKind::kPose, p), DecodeResult::kBadCovariance);
 }
 
 TEST_F(SampleDecoderTest, UnknownOrEmptyFrames) {
