@@ -1,0 +1,188 @@
+// FusionCore through its real input path: encoded LCM messages -> InputRouter
+// -> rings -> tick -> snapshot.
+#include "runtime/fusion_core.hpp"
+
+#include <cmath>
+#include <vector>
+
+#include <gtest/gtest.h>
+
+#include "geometry/rotation.hpp"
+#include "rtfuse/odometry_t.hpp"
+#include "rtfuse/pose_with_covariance_stamped_t.hpp"
+#include "runtime/config_loader.hpp"
+#include "support/alloc_counter.hpp"
+
+namespace rtfuse {
+namespace {
+
+constexpr const char* kTwoYawSources = R"(
+[filter]
+frequency = 100
+sensor_timeout = 0.5
+
+[[sensor]]
+name = "odom0"
+type = "odometry"
+channel = "odom"
+config = [false, false, false, false, false, true,
+          true,  false, false, false, false, true,
+          false, false, false]
+
+[[sensor]]
+name = "odom1"
+type = "odometry"
+channel = "compass"
+config = [false, false, false, false, false, true,
+          false, false, false, false, false, false,
+          false, false, false]
+queue_size = 2
+)";
+
+RuntimeConfig load(const char* text) {
+  ConfigLoadResult r = load_config_string(text, "test.toml");
+  if (!r.config) {
+    for (const auto& e : r.errors) ADD_FAILURE() << e.to_string();
+  }
+  return *r.config;
+}
+
+std::vector<std::uint8_t> odometry(TimeNs t, double yaw, double vx) {
+  rtfuse::odometry_t m{};
+  m.header.utime = ns_to_utime(t);
+  m.header.frame_id = "odom";
+  m.child_frame_id = "base_link";
+  const Eigen::Quaterniond q = geometry::quaternion_from_rpy(0, 0, yaw);
+  m.pose.pose.orientation = {q.x(), q.y(), q.z(), q.w()};
+  for (int i = 0; i < 6; ++i) {
+    m.pose.covariance[i * 7] = 0.01;
+    m.twist.covariance[i * 7] = 0.01;
+  }
+  m.twist.twist.linear.x = vx;
+  std::vector<std::uint8_t> buf(m.getEncodedSize());
+  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  return buf;
+}
+
+Snapshot snap(const FusionCore& core) {
+  Snapshot s;
+  core.snapshot().load(s);
+  return s;
+}
+
+TEST(FusionCore, ConflictingAbsoluteYawIsGatedNotAveraged) {
+  std::string err;
+  auto core = FusionCore::create(load(kTwoYawSources), &err);
+  ASSERT_TRUE(core) << err;
+  LoopStats loop;
+  TimeNs t = 1'000'000'000;
+  for (int i = 0; i < 200; ++i, t += 10'000'000) {
+    auto a = odometry(t, 0.0, 0.0);
+    ASSERT_TRUE(core->input().on_message("odom", a.data(), static_cast<int>(a.size())));
+    if (i % 5 == 0) {
+      auto b = odometry(t, 1.0, 0.0);  // a compass 1 rad off
+      core->input().on_message("compass", b.data(), static_cast<int>(b.size()));
+    }
+    core->tick(t, loop);
+    EXPECT_LT(std::abs(snap(*core).state[5]), 0.05) << "yaw pulled away at step " << i;
+  }
+  const Snapshot s = snap(*core);
+  EXPECT_GE(s.sensors[1].yaw_conflicts, 39);
+  EXPECT_EQ(s.sensors[0].yaw_conflicts, 0);
+}
+
+TEST(FusionCore, MessageOlderThanThePreviousOfItsSensorIsRejected) {
+  std::string err;
+  auto core = FusionCore::create(load(kTwoYawSources), &err);
+  ASSERT_TRUE(core) << err;
+  LoopStats loop;
+  auto m1 = odometry(2'000'000'000, 0.0, 1.0);
+  auto m0 = odometry(1'000'000'000, 0.0, 1.0);  // time goes backwards
+  core->input().on_message("odom", m1.data(), static_cast<int>(m1.size()));
+  core->tick(2'000'000'000, loop);
+  core->input().on_message("odom", m0.data(), static_cast<int>(m0.size()));
+  core->tick(2'010'000'000, loop);
+  const Snapshot s = snap(*core);
+  EXPECT_EQ(s.sensors[0].accepted, 1);
+  EXPECT_EQ(s.sensors[0].rejected_invalid, 1);
+}
+
+TEST(FusionCore, RingOverflowIsCountedNotHidden) {
+  std::string err;
+  auto core = FusionCore::create(load(kTwoYawSources), &err);
+  ASSERT_TRUE(core) << err;
+  for (int i = 0; i < 10; ++i) {  // compass ring holds 2 * queue_size = 4
+    auto b = odometry(1'000'000'000 + i, 0.0, 0.0);
+    core->input().on_message("compass", b.data(), static_cast<int>(b.size()));
+  }
+  core->tick(1'100'000'000, LoopStats{});
+  const Snapshot s = snap(*core);
+  EXPECT_EQ(s.sensors[1].received, 10);
+  EXPECT_EQ(s.sensors[1].rejected_overflow, 6);
+  EXPECT_EQ(s.sensors[1].accepted, 4);
+}
+
+TEST(FusionCore, SetPoseChannelResetsTheEstimate) {
+  std::string err;
+  RuntimeConfig cfg = load(kTwoYawSources);
+  auto core = FusionCore::create(cfg, &err);
+  ASSERT_TRUE(core) << err;
+  TimeNs t = 1'000'000'000;
+  for (int i = 0; i < 100; ++i, t += 10'000'000) {
+    auto a = odometry(t, 0.0, 1.0);
+    core->input().on_message("odom", a.data(), static_cast<int>(a.size()));
+    core->tick(t, LoopStats{});
+  }
+  EXPECT_GT(snap(*core).state[0], 0.9);  // drove ~1 m
+
+  rtfuse::pose_with_covariance_stamped_t p{};
+  p.header.utime = ns_to_utime(t);
+  p.header.frame_id = "odom";
+  p.pose.pose.position = {5.0, -2.0, 0.0};
+  const Eigen::Quaterniond q = geometry::quaternion_from_rpy(0, 0, 0.5);
+  p.pose.pose.orientation = {q.x(), q.y(), q.z(), q.w()};
+  for (int i = 0; i < 6; ++i) p.pose.covariance[i * 7] = 0.1;
+  std::vector<std::uint8_t> buf(p.getEncodedSize());
+  p.encode(buf.data(), 0, static_cast<int>(buf.size()));
+  ASSERT_TRUE(core->input().on_message(cfg.publish.set_pose_channel.c_str(), buf.data(), static_cast<int>(buf.size())));
+  core->tick(t, LoopStats{});
+  const Snapshot s = snap(*core);
+  EXPECT_NEAR(s.state[0], 5.0, 1e-9);
+  EXPECT_NEAR(s.state[1], -2.0, 1e-9);
+  EXPECT_NEAR(s.state[5], 0.5, 1e-9);
+  EXPECT_EQ(s.state[6], 0.0);  // velocities restart at zero
+  EXPECT_NEAR(s.covariance[0], 0.1, 1e-12);
+  EXPECT_EQ(s.set_pose_count, 1);
+}
+
+TEST(FusionCore, UnknownChannelIsCounted) {
+  std::string err;
+  auto core = FusionCore::create(load(kTwoYawSources), &err);
+  ASSERT_TRUE(core) << err;
+  const std::uint8_t junk[4] = {1, 2, 3, 4};
+  EXPECT_FALSE(core->input().on_message("nobody/listens", junk, 4));
+  core->tick(1, LoopStats{});
+  EXPECT_EQ(snap(*core).unknown_channel_messages, 1);
+}
+
+TEST(FusionCore, SteadyStateTicksDoNotAllocate) {
+  std::string err;
+  auto core = FusionCore::create(load(kTwoYawSources), &err);
+  ASSERT_TRUE(core) << err;
+  std::vector<std::vector<std::uint8_t>> msgs;
+  for (int i = 0; i < 300; ++i) msgs.push_back(odometry(1'000'000'000 + i * 10'000'000LL, 0.01 * i, 1.0));
+  for (int i = 0; i < 10; ++i) {  // warm up: first decode sizes the strings
+    core->input().on_message("odom", msgs[i].data(), static_cast<int>(msgs[i].size()));
+    core->tick(1'000'000'000 + i * 10'000'000LL, LoopStats{});
+  }
+  test::AllocScope scope;
+  for (int i = 10; i < 300; ++i) {
+    core->input().on_message("odom", msgs[i].data(), static_cast<int>(msgs[i].size()));
+    core->tick(1'000'000'000 + i * 10'000'000LL, LoopStats{});
+  }
+  EXPECT_EQ(scope.count(), 0u);
+  EXPECT_EQ(snap(*core).sensors[0].accepted, 300);
+}
+
+}  // namespace
+}  // namespace rtfuse
