@@ -279,7 +279,8 @@ TEST(ConfigLoader, DefaultsFollowTheKeysTheyDependOn) {
 }
 
 TEST(ConfigLoader, SensorDefaults) {
-  const RuntimeConfig& c = ok_config(load(sensor("imu0", "imu", "imu/data")));
+  const auto r = load(sensor("imu0", "imu", "imu/data"));
+  const RuntimeConfig& c = ok_config(r);
   ASSERT_EQ(c.num_sensors, 1);
   const est::SensorParams& p = c.sensors[0].params;
   EXPECT_EQ(p.update_mask, est::mask_bit(est::kYaw) | est::mask_bit(est::kVyaw));
