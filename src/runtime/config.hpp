@@ -68,7 +68,10 @@ struct SimConfig {
   double accel_noise_mps2 = 0.05;
   double accel_bias_mps2 = 0.05;
   double orientation_noise_rad = 0.01;
-  double yaw_drift_rad_s = 0.002;
+  // The IMU's own yaw, as a magnetometer-aided AHRS reports it: an error that
+  // wanders (first-order Gauss-Markov) but stays bounded.
+  double yaw_error_rad = 0.02;     // its standard deviation
+  double yaw_error_time_s = 30.0;  // its correlation time
   double odom_speed_noise_mps = 0.02;
   double odom_yaw_rate_noise_rad_s = 0.02;
   double wheel_slip = 0.03;   // fractional speed error (scale), as on a real floor

@@ -710,7 +710,7 @@ void read_static_transforms(const Section& root, RuntimeConfig& cfg) {
 void read_sim(const Section& s, SimConfig& sim) {
   s.reject_unknown({"enabled", "seed", "radius", "speed", "imu_rate", "odom_rate", "imu_channel",
                     "odom_channel", "truth_channel", "gyro_noise", "gyro_bias", "accel_noise",
-                    "accel_bias", "orientation_noise", "yaw_drift", "odom_speed_noise",
+                    "accel_bias", "orientation_noise", "yaw_error", "yaw_error_time", "odom_speed_noise",
                     "odom_yaw_rate_noise", "wheel_slip"});
   s.read("enabled", sim.enabled);
   read_int(s, "seed", sim.seed, 0, std::numeric_limits<std::int64_t>::max());
@@ -727,10 +727,11 @@ void read_sim(const Section& s, SimConfig& sim) {
       {"accel_noise", &sim.accel_noise_mps2},
       {"accel_bias", &sim.accel_bias_mps2},
       {"orientation_noise", &sim.orientation_noise_rad},
-      {"yaw_drift", &sim.yaw_drift_rad_s},
+      {"yaw_error", &sim.yaw_error_rad},
       {"odom_speed_noise", &sim.odom_speed_noise_mps},
       {"odom_yaw_rate_noise", &sim.odom_yaw_rate_noise_rad_s}};
   for (const auto& [k, v] : magnitudes) read_number(s, k, *v, non_negative_finite, "must be >= 0 and finite");
+  read_number(s, "yaw_error_time", sim.yaw_error_time_s, positive_finite, "must be > 0 s and finite");
   read_number(s, "wheel_slip", sim.wheel_slip, [](double v) { return v >= 0 && v < 1; },
               "must be >= 0 and < 1");
 }

@@ -215,6 +215,8 @@ struct SimRobot::Impl {
   TimeNs start;
   FigureEight path;
   Gaussian imu_noise;
+  double yaw_error = 0.0;       // the IMU's current yaw error
+  TimeNs last_imu_stamp = 0;
   Gaussian odom_noise;
   SimBiases biases{};
   double slip_phase[4] = {};  // left wheel: 0, 1; right wheel: 2, 3
@@ -236,11 +238,16 @@ void SimRobot::Impl::build_imu(TimeNs stamp) noexcept {
   m.header.seq = static_cast<std::int32_t>(imu.seq++);
 
   const double so = cfg.orientation_noise_rad;
-  const double drift = cfg.yaw_drift_rad_s * t;
-  set_quaternion(m.orientation, so * imu_noise(), so * imu_noise(), wrap(k.yaw + drift + so * imu_noise()));
-  // The drift is an error the IMU's own filter accumulates; an honest driver
-  // grows its yaw variance with it rather than claim the white-noise level.
-  set_diagonal(m.orientation_covariance, 3, 2, variance(so) + drift * drift);
+  // First-order Gauss-Markov yaw error: e <- a e + s sqrt(1 - a^2) w keeps its
+  // standard deviation at yaw_error however long the drive, as the
+  // magnetometer of an AHRS does; between corrections it wanders.
+  const double dt = last_imu_stamp == 0 ? 0.0 : ns_to_sec(stamp - last_imu_stamp);
+  last_imu_stamp = stamp;
+  const double a = std::exp(-dt / cfg.yaw_error_time_s);
+  yaw_error = a * yaw_error + cfg.yaw_error_rad * std::sqrt(1.0 - a * a) * imu_noise();
+  set_quaternion(m.orientation, so * imu_noise(), so * imu_noise(), wrap(k.yaw + yaw_error + so * imu_noise()));
+  // An honest driver reports the error it knows it has, not the white-noise level.
+  set_diagonal(m.orientation_covariance, 3, 2, variance(so) + variance(cfg.yaw_error_rad));
 
   const double sg = cfg.gyro_noise_rad_s;
   m.angular_velocity.x = biases.gyro[0] + sg * imu_noise();

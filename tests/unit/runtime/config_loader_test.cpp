@@ -144,7 +144,8 @@ gyro_bias = 0
 accel_noise = 0.1
 accel_bias = 0.2
 orientation_noise = 0.3
-yaw_drift = 0.004
+yaw_error = 0.004
+yaw_error_time = 12.5
 odom_speed_noise = 0.05
 odom_yaw_rate_noise = 0.06
 wheel_slip = 0.1
@@ -233,7 +234,8 @@ TEST(ConfigLoader, FullConfigParsesToTheRightValues) {
   EXPECT_DOUBLE_EQ(c.sim.accel_noise_mps2, 0.1);
   EXPECT_DOUBLE_EQ(c.sim.accel_bias_mps2, 0.2);
   EXPECT_DOUBLE_EQ(c.sim.orientation_noise_rad, 0.3);
-  EXPECT_DOUBLE_EQ(c.sim.yaw_drift_rad_s, 0.004);
+  EXPECT_DOUBLE_EQ(c.sim.yaw_error_rad, 0.004);
+  EXPECT_DOUBLE_EQ(c.sim.yaw_error_time_s, 12.5);
   EXPECT_DOUBLE_EQ(c.sim.odom_speed_noise_mps, 0.05);
   EXPECT_DOUBLE_EQ(c.sim.odom_yaw_rate_noise_rad_s, 0.06);
   EXPECT_DOUBLE_EQ(c.sim.wheel_slip, 0.1);

@@ -182,15 +182,15 @@ TEST(SimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
     const TimeNs h = 1'000'000;
     const double accel = (robot.truth(c.stamp + h).vx - robot.truth(c.stamp - h).vx) / 2e-3;
     ax.add(imu.linear_acceleration.x - accel);
-    yaw.add(angle_diff(yaw_of(imu.orientation), truth.yaw + cfg.yaw_drift_rad_s * t));
+    yaw.add(angle_diff(yaw_of(imu.orientation), truth.yaw));
+    (void)t;
 
     EXPECT_EQ(imu.angular_velocity_covariance[8], cfg.gyro_noise_rad_s * cfg.gyro_noise_rad_s);
     EXPECT_EQ(imu.linear_acceleration_covariance[0], cfg.accel_noise_mps2 * cfg.accel_noise_mps2);
     EXPECT_EQ(imu.orientation_covariance[1], 0.0);
-    // The yaw variance owns up to the drift so far.
-    const double drift = cfg.yaw_drift_rad_s * t;
-    EXPECT_NEAR(imu.orientation_covariance[8], cfg.orientation_noise_rad * cfg.orientation_noise_rad + drift * drift,
-                1e-15);
+    // The yaw variance owns up to the AHRS's wandering error, not just white noise.
+    EXPECT_NEAR(imu.orientation_covariance[8],
+                cfg.orientation_noise_rad * cfg.orientation_noise_rad + cfg.yaw_error_rad * cfg.yaw_error_rad, 1e-15);
   }
   ASSERT_EQ(wz.n, 1000);
   // Means within 5 standard errors, spreads within 15 % of the configured noise.
@@ -203,8 +203,29 @@ TEST(SimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
   EXPECT_NEAR(ay.mean(), bias.accel[1], accel_se);
   EXPECT_NEAR(az.mean(), 9.80665 + bias.accel[2], accel_se);
   EXPECT_NEAR(az.stddev(), cfg.accel_noise_mps2, 0.15 * cfg.accel_noise_mps2);
-  EXPECT_NEAR(yaw.mean(), 0.0, 5 * cfg.orientation_noise_rad / std::sqrt(yaw.n));
-  EXPECT_NEAR(yaw.stddev(), cfg.orientation_noise_rad, 0.15 * cfg.orientation_noise_rad);
+  // Over 10 s the 30 s-correlated error barely moves: its mean is one draw.
+  EXPECT_LT(std::abs(yaw.mean()), 4 * cfg.yaw_error_rad);
+  EXPECT_GT(yaw.stddev(), 0.85 * cfg.orientation_noise_rad);
+  EXPECT_LT(yaw.stddev(), std::hypot(cfg.orientation_noise_rad, cfg.yaw_error_rad));
+}
+
+TEST(SimRobot, ImuYawErrorStaysBoundedOverALongDrive) {
+  SimConfig cfg;
+  cfg.imu_rate_hz = 20.0;  // fewer messages, same error process
+  SimRobot robot(cfg, kStart);
+  Stats yaw;
+  double worst = 0.0;
+  for (const auto& c : drain(robot, kStart + 1200 * kSec)) {
+    if (c.channel != "imu/data") continue;
+    const double e = angle_diff(yaw_of(decode<rtfuse::imu_t>(c).orientation), robot.truth(c.stamp).yaw);
+    yaw.add(e);
+    worst = std::max(worst, std::abs(e));
+  }
+  const double sigma = std::hypot(cfg.orientation_noise_rad, cfg.yaw_error_rad);
+  // 20 minutes = 40 correlation times: a drifting error would be far beyond these.
+  EXPECT_NEAR(yaw.stddev(), sigma, 0.35 * sigma);
+  EXPECT_LT(std::abs(yaw.mean()), sigma);
+  EXPECT_LT(worst, 5.5 * sigma);
 }
 
 TEST(SimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
