@@ -2,7 +2,6 @@
 
 #include <cmath>
 
-#include <Eigen/Cholesky>
 
 #include "estimation/motion_model.hpp"
 #include "geometry/angles.hpp"
@@ -17,48 +16,54 @@ void wrap_state_angles(StateVector& x) noexcept {
   x(kYaw) = wrap_angle(x(kYaw));
 }
 
+namespace {
+
+// a <- a F' for the motion Jacobian F, in place. F is identity except rows
+// x..vz, so only columns x..vz of a change, each a combination of a few
+// columns: column operations on a column-major matrix vectorise, and this is
+// ~700 multiply-adds instead of 3375 for a dense product.
+void right_multiply_jacobian_transpose(StateMatrix& a, const MotionJacobian& j) noexcept {
+  const Eigen::Matrix<double, kStateSize, 3> rpy = a.middleCols<3>(kRoll);
+  a.middleCols<3>(kX).noalias() += rpy.lazyProduct(j.pos_rpy.transpose());
+  a.middleCols<3>(kX).noalias() += a.middleCols<3>(kVx).lazyProduct(j.pos_vel.transpose());
+  a.middleCols<3>(kX).noalias() += a.middleCols<3>(kAx).lazyProduct(j.pos_acc.transpose());
+  a.middleCols<3>(kRoll).noalias() = rpy.lazyProduct(j.rpy_rpy.transpose());
+  a.middleCols<3>(kRoll).noalias() += a.middleCols<3>(kVroll).lazyProduct(j.rpy_rate.transpose());
+  a.middleCols<3>(kVx) += j.vel_acc * a.middleCols<3>(kAx);
+}
+
+}  // namespace
+
 void Ekf::predict(double dt) noexcept {
   if (!(dt > 0.0)) return;
   // The Jacobian is evaluated at the prior state, as robot_localization does.
-  const MotionJacobian j = motion_model_jacobian(x_, dt);
-  motion_model_predict(x_, dt);
+  const MotionJacobian j = motion_model_step(x_, dt);
   wrap_state_angles(x_);
 
-  // P <- F P F'. F is identity except rows x..vz, so only those rows (then
-  // columns) are touched: ~1.4k multiply-adds instead of ~6.7k for a dense
-  // 15x15 triple product.
-  StateMatrix m = p_;
-  m.middleRows<3>(kX).noalias() += j.pos_rpy * p_.middleRows<3>(kRoll);
-  m.middleRows<3>(kX).noalias() += j.pos_vel * p_.middleRows<3>(kVx);
-  m.middleRows<3>(kX).noalias() += j.pos_acc * p_.middleRows<3>(kAx);
-  m.middleRows<3>(kRoll).noalias() = j.rpy_rpy * p_.middleRows<3>(kRoll);
-  m.middleRows<3>(kRoll).noalias() += j.rpy_rate * p_.middleRows<3>(kVroll);
-  m.middleRows<3>(kVx) += j.vel_acc * p_.middleRows<3>(kAx);
-
-  p_ = m;
-  p_.middleCols<3>(kX).noalias() += m.middleCols<3>(kRoll) * j.pos_rpy.transpose();
-  p_.middleCols<3>(kX).noalias() += m.middleCols<3>(kVx) * j.pos_vel.transpose();
-  p_.middleCols<3>(kX).noalias() += m.middleCols<3>(kAx) * j.pos_acc.transpose();
-  p_.middleCols<3>(kRoll).noalias() = m.middleCols<3>(kRoll) * j.rpy_rpy.transpose();
-  p_.middleCols<3>(kRoll).noalias() += m.middleCols<3>(kVroll) * j.rpy_rate.transpose();
-  p_.middleCols<3>(kVx) += j.vel_acc * m.middleCols<3>(kAx);
+  // F P F' = (P F')' F' because P is symmetric: two passes of column
+  // operations with a transpose between them.
+  StateMatrix a = p_;
+  right_multiply_jacobian_transpose(a, j);
+  p_ = a.transpose();
+  right_multiply_jacobian_transpose(p_, j);
 
   if (dynamic_process_noise_) {
     // robot_localization scales the pose block of Q by the norm of the full
     // twist (linear and angular together), on both sides.
-    const double speed = x_.segment<6>(kVx).norm();
-    StateMatrix q = process_noise_;
-    q.topLeftCorner<6, 6>() *= speed * speed;
-    p_.noalias() += q * dt;
+    const double speed2 = x_.segment<6>(kVx).squaredNorm();
+    p_.topLeftCorner<6, 6>() += process_noise_.topLeftCorner<6, 6>() * (speed2 * dt);
+    p_.bottomRows<9>() += process_noise_.bottomRows<9>() * dt;
+    p_.topRightCorner<6, 9>() += process_noise_.topRightCorner<6, 9>() * dt;
   } else {
-    p_.noalias() += process_noise_ * dt;
+    p_ += process_noise_ * dt;
   }
   condition_covariance();
 }
 
 void Ekf::condition_covariance() noexcept {
-  // Round-off makes F P F' drift from symmetric; keep it exactly symmetric.
-  p_ = 0.5 * (p_ + p_.transpose()).eval();
+  // Round-off makes P drift from symmetric; mirror the upper triangle so it
+  // stays exactly symmetric (a copy, no arithmetic).
+  p_.triangularView<Eigen::StrictlyLower>() = p_.transpose();
   // Scaling row and column i by s is a congruence with diag(.., s, ..): it
   // keeps P positive semi-definite while bringing P(i,i) down to the cap.
   for (int i = 0; i < kStateSize; ++i) {
@@ -111,6 +116,51 @@ CorrectResult Ekf::correct(const Measurement& m) noexcept {
   return r;
 }
 
+namespace {
+
+// Inverse of a symmetric positive-definite N x N matrix through its Cholesky
+// factor, in plain fixed-size loops: at these sizes Eigen's solve() goes
+// through its blocked triangular-solve kernels, whose packing costs more than
+// the arithmetic. Returns false when s is not positive definite.
+template <int N>
+bool invert_spd(const Eigen::Matrix<double, N, N>& s, Eigen::Matrix<double, N, N>* inverse) noexcept {
+  double l[N][N] = {};
+  for (int j = 0; j < N; ++j) {
+    double d = s(j, j);
+    for (int k = 0; k < j; ++k) d -= l[j][k] * l[j][k];
+    if (!(d > 0.0)) return false;
+    l[j][j] = std::sqrt(d);
+    const double inv = 1.0 / l[j][j];
+    for (int i = j + 1; i < N; ++i) {
+      double v = s(i, j);
+      for (int k = 0; k < j; ++k) v -= l[i][k] * l[j][k];
+      l[i][j] = v * inv;
+    }
+  }
+  // L^-1 by forward substitution (lower triangular).
+  double li[N][N] = {};
+  for (int j = 0; j < N; ++j) {
+    li[j][j] = 1.0 / l[j][j];
+    for (int i = j + 1; i < N; ++i) {
+      double v = 0.0;
+      for (int k = j; k < i; ++k) v -= l[i][k] * li[k][j];
+      li[i][j] = v / l[i][i];
+    }
+  }
+  // S^-1 = L^-T L^-1, symmetric: fill both halves from one.
+  for (int i = 0; i < N; ++i) {
+    for (int j = 0; j <= i; ++j) {
+      double v = 0.0;
+      for (int k = i; k < N; ++k) v += li[k][i] * li[k][j];
+      (*inverse)(i, j) = v;
+      (*inverse)(j, i) = v;
+    }
+  }
+  return true;
+}
+
+}  // namespace
+
 // H is a selection matrix (row a picks state idx[a]), so H P H' and P H' are
 // gathers and no H is ever formed. Dispatching on the update size N keeps
 // every matrix fixed-size (no Eigen::Dynamic, no allocation).
@@ -128,22 +178,20 @@ CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept 
     innovation(a) = m.z(ia) - x_(ia);
     if (is_angle_index(ia)) innovation(a) = wrap_angle(innovation(a));
     u.col(a) = p_.col(ia);
-    for (int b = 0; b < N; ++b) s(a, b) = m.covariance(ia, idx[b]);
+    for (int b = 0; b < N; ++b) s(a, b) = m.covariance(ia, idx[b]) + p_(ia, idx[b]);
     // As robot_localization: negative variances are taken as their magnitude
     // and near-zero ones floored, so a "perfect" sensor cannot make S singular.
-    s(a, a) = std::max(std::abs(s(a, a)), 1e-9);
-  }
-  for (int a = 0; a < N; ++a) {
-    for (int b = 0; b < N; ++b) s(a, b) += p_(idx[a], idx[b]);
+    const double r = m.covariance(ia, ia);
+    s(a, a) += std::max(std::abs(r), 1e-9) - r;
   }
 
   CorrectResult result;
-  const Eigen::LLT<MatN> llt(s);
-  if (llt.info() != Eigen::Success) {
+  MatN s_inv;
+  if (!invert_spd<N>(s, &s_inv)) {
     result.outcome = CorrectOutcome::kRejectedNumeric;
     return result;
   }
-  const VecN s_inv_innovation = llt.solve(innovation);
+  const VecN s_inv_innovation = s_inv.lazyProduct(innovation);
   result.squared_mahalanobis = innovation.dot(s_inv_innovation);
   if (!std::isfinite(result.squared_mahalanobis) ||
       result.squared_mahalanobis >= m.mahalanobis_threshold * m.mahalanobis_threshold) {
@@ -153,17 +201,15 @@ CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept 
     return result;
   }
 
-  // K = P H' S^-1, from S K' = H P.
-  const Eigen::Matrix<double, N, kStateSize> kt = llt.solve(u.transpose());
-  const MatXN k = kt.transpose();
-
-  const StateVector x_new = x_ + k * innovation;
+  // K = P H' S^-1.
+  const MatXN k = u.lazyProduct(s_inv);
+  const StateVector x_new = x_ + u.lazyProduct(s_inv_innovation);
   // Joseph form (I-KH) P (I-KH)' + K R K', expanded for a selection H:
   //   P - K U' - U K' + K S K'  with U = P H', S = H P H' + R.
   // It equals the product form for any gain K (no optimality assumed) and is
   // symmetric by construction as P + B + B' with B = (K S / 2 - U) K'.
-  const MatXN w = 0.5 * (k * s) - u;
-  const StateMatrix b = w * kt;
+  const MatXN w = 0.5 * k.lazyProduct(s) - u;
+  const StateMatrix b = w.lazyProduct(k.transpose());
   StateMatrix p_new = p_ + b + b.transpose();
 
   if (!x_new.allFinite() || !p_new.allFinite()) {

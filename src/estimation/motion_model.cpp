@@ -10,8 +10,14 @@ struct Trig {
 };
 
 Trig trig_of(const StateVector& x) noexcept {
-  return {std::sin(x(kRoll)), std::cos(x(kRoll)), std::sin(x(kPitch)),
-          std::cos(x(kPitch)), std::sin(x(kYaw)), std::cos(x(kYaw))};
+  Trig t;
+  t.sr = std::sin(x(kRoll));
+  t.cr = std::cos(x(kRoll));
+  t.sp = std::sin(x(kPitch));
+  t.cp = std::cos(x(kPitch));
+  t.sy = std::sin(x(kYaw));
+  t.cy = std::cos(x(kYaw));
+  return t;
 }
 
 // Body-to-world rotation, R = Rz(yaw) Ry(pitch) Rx(roll), as tf2.
@@ -23,11 +29,7 @@ Eigen::Matrix3d body_to_world(const Trig& t) noexcept {
   return r;
 }
 
-}  // namespace
-
-void motion_model_predict(StateVector& x, double dt) noexcept {
-  const Trig t = trig_of(x);
-  const Eigen::Matrix3d r = body_to_world(t);
+void predict_with(const Trig& t, const Eigen::Matrix3d& r, StateVector& x, double dt) noexcept {
   const Eigen::Vector3d v = x.segment<3>(kVx);
   const Eigen::Vector3d a = x.segment<3>(kAx);
   const double tp = t.sp / t.cp;
@@ -41,9 +43,7 @@ void motion_model_predict(StateVector& x, double dt) noexcept {
   x.segment<3>(kVx) += a * dt;
 }
 
-MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept {
-  const Trig t = trig_of(x);
-  const Eigen::Matrix3d r = body_to_world(t);
+MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const StateVector& x, double dt) noexcept {
   const Eigen::Vector3d s = x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx);
   const double vp = x(kVpitch), vy = x(kVyaw);
   const double tp = t.sp / t.cp;
@@ -80,6 +80,26 @@ MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept {
                 0.0, t.sr / t.cp, t.cr / t.cp;
   j.rpy_rate *= dt;
   j.vel_acc = dt;
+  return j;
+}
+
+}  // namespace
+
+void motion_model_predict(StateVector& x, double dt) noexcept {
+  const Trig t = trig_of(x);
+  predict_with(t, body_to_world(t), x, dt);
+}
+
+MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept {
+  const Trig t = trig_of(x);
+  return jacobian_with(t, body_to_world(t), x, dt);
+}
+
+MotionJacobian motion_model_step(StateVector& x, double dt) noexcept {
+  const Trig t = trig_of(x);
+  const Eigen::Matrix3d r = body_to_world(t);
+  const MotionJacobian j = jacobian_with(t, r, x, dt);
+  predict_with(t, r, x, dt);
   return j;
 }
 

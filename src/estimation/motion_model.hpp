@@ -21,6 +21,10 @@ struct MotionJacobian {
 
 MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept;
 
+// Both at once, sharing the trigonometry (the filter's hot path): returns the
+// Jacobian at the prior x and advances x.
+MotionJacobian motion_model_step(StateVector& x, double dt) noexcept;
+
 // The same Jacobian as a dense matrix, for tests and readers.
 StateMatrix motion_model_jacobian_dense(const StateVector& x, double dt) noexcept;
 
