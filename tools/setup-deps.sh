@@ -6,7 +6,7 @@ set -euo pipefail
 packages=(
   g++ cmake ninja-build make
   libeigen3-dev
-  liblcm-dev liblcm-bin liblcm-java
+  liblcm-dev liblcm-bin liblcm-java libjchart2d-java
   libtomlplusplus-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless

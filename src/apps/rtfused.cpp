@@ -22,7 +22,7 @@ namespace rtfuse::apps {
 extern const std::string_view kEmbeddedSimConfig;
 }
 
-// Optional hook for the allocation probe (tests/support/alloc_probe.c, loaded
+// Optional hook for the allocation probe (tests/system/alloc_probe.c, loaded
 // with LD_PRELOAD): told when start-up is over and when shutdown begins.
 extern "C" void rtfuse_alloc_probe_steady(int steady) __attribute__((weak));
 

@@ -22,15 +22,31 @@ struct CorrectResult {
 
 class Ekf {
  public:
+  // P is kept padded to 16 x 16 with a zero last row and column: columns of
+  // 16 doubles are whole SSE2/NEON packets, which makes the covariance
+  // products ~1.5x faster than with 15 rows. The padding stays exactly zero
+  // through every operation, and nothing outside this class sees it.
+  using PaddedMatrix = Eigen::Matrix<double, kStateSize + 1, kStateSize + 1>;
+
   // Process noise per second (Q·dt is added per prediction).
-  void set_process_noise(const StateMatrix& q) noexcept { process_noise_ = q; }
+  void set_process_noise(const StateMatrix& q) noexcept {
+    process_noise_.setZero();
+    process_noise_.topLeftCorner<kStateSize, kStateSize>() = q;
+    // robot_localization configs are nearly always diagonal: then Q dt is a
+    // diagonal add instead of a full matrix pass.
+    process_noise_diagonal_ = q.isDiagonal(0.0);
+  }
   void set_dynamic_process_noise(bool on) noexcept { dynamic_process_noise_ = on; }
   void set_max_variance(double v) noexcept { max_variance_ = v; }
 
   void set_state(const StateVector& x) noexcept { x_ = x; }
-  void set_covariance(const StateMatrix& p) noexcept { p_ = p; }
+  void set_covariance(const StateMatrix& p) noexcept {
+    p_.setZero();
+    p_.topLeftCorner<kStateSize, kStateSize>() = p;
+  }
   const StateVector& state() const noexcept { return x_; }
-  const StateMatrix& covariance() const noexcept { return p_; }
+  StateMatrix covariance() const noexcept { return p_.topLeftCorner<kStateSize, kStateSize>(); }
+  double variance(int i) const noexcept { return p_(i, i); }
 
   // x <- f(x, dt); P <- F P F' + Q dt, with P kept symmetric and capped.
   void predict(double dt) noexcept;
@@ -43,9 +59,16 @@ class Ekf {
   void condition_covariance() noexcept;
 
   StateVector x_ = StateVector::Zero();
-  StateMatrix p_ = StateMatrix::Identity() * 1e-9;
-  StateMatrix process_noise_ = StateMatrix::Zero();
+  PaddedMatrix p_ = identity_covariance();
+  PaddedMatrix process_noise_ = PaddedMatrix::Zero();
+
+  static PaddedMatrix identity_covariance() {
+    PaddedMatrix p = PaddedMatrix::Identity() * 1e-9;
+    p(kStateSize, kStateSize) = 0.0;
+    return p;
+  }
   bool dynamic_process_noise_ = false;
+  bool process_noise_diagonal_ = true;
   double max_variance_ = 1e6;
 };
 

@@ -31,7 +31,7 @@ class Filter {
   bool has_time() const noexcept { return has_time_; }
   TimeNs last_measurement_time() const noexcept { return last_time_; }
   const StateVector& state() const noexcept { return ekf_.state(); }
-  const StateMatrix& covariance() const noexcept { return ekf_.covariance(); }
+  StateMatrix covariance() const noexcept { return ekf_.covariance(); }
   const FilterParams& params() const noexcept { return params_; }
 
   ProcessResult process(const Measurement& m) noexcept;

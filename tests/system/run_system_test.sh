@@ -1,0 +1,192 @@
+#!/usr/bin/env bash
+# run_system_test.sh MODE OUTDIR RTFUSED [NAME=VALUE]...
+#
+# The system tests: the real rtfused and real LCM tools as separate processes
+# over real UDP multicast, inside a private network namespace so that no
+# packet ever leaves it (multicast is routed to lo and the URL has ttl=0).
+#
+#   udp_multicast  lcm-logger records ~5 s of rtfused's outputs; check_system.py
+#                  checks channels, counts, rates, rtfused's exit and summary
+#   jvm_decode     the same recording, then every rtfuse/* event decoded by the
+#                  JVM with the generated classes, as lcm-spy would (plus two
+#                  damaged copies of the log that must be rejected)
+#   zero_alloc     rtfused under LD_PRELOAD=alloc_probe: no heap allocation in
+#                  steady state, in any thread (after the probe's self-test)
+#
+# NAME=VALUE settings (passed by tests/system/CMakeLists.txt):
+#   PYTHON CHECK TOOLS_DIR JAVA CLASSPATH_DECODE PROBE PROBE_SELFTEST
+#
+# Exit: 0 pass, 1 fail, 77 skipped (no network namespace and
+# RTFUSE_SKIP_NETNS=1, or no JVM for jvm_decode).
+set -euo pipefail
+
+SKIP=77
+URL='udpm://239.255.76.67:7667?ttl=0'
+
+if [[ $# -lt 3 ]]; then
+  echo "usage: $0 udp_multicast|jvm_decode|zero_alloc OUTDIR RTFUSED [NAME=VALUE]..." >&2
+  exit 2
+fi
+mode=$1 outdir=$2 rtfused=$3
+shift 3
+PYTHON=/usr/bin/python3 CHECK= TOOLS_DIR= JAVA= CLASSPATH_DECODE= PROBE= PROBE_SELFTEST=
+for kv in "$@"; do
+  case "$kv" in
+    PYTHON=* | CHECK=* | TOOLS_DIR=* | JAVA=* | CLASSPATH_DECODE=* | PROBE=* | PROBE_SELFTEST=*)
+      printf -v "${kv%%=*}" '%s' "${kv#*=}" ;;
+    *) echo "$0: unknown setting '$kv'" >&2; exit 2 ;;
+  esac
+done
+case "$mode" in udp_multicast | jvm_decode | zero_alloc) ;; *) echo "$0: unknown mode '$mode'" >&2; exit 2 ;; esac
+
+say() { echo "[$mode] $*"; }
+die() { echo "[$mode] FAIL: $*"; exit 1; }
+
+# ---------------------------------------------------------------------------
+# Outside the namespace: check the prerequisites, then re-run this script
+# under unshare -n.
+if [[ "${RTFUSE_SYSTEM_TEST_IN_NETNS:-}" != "1" ]]; then
+  [[ -x "$rtfused" ]] || die "rtfused not found or not executable: $rtfused"
+  if [[ "$mode" == jvm_decode && ( -z "$JAVA" || ! -x "$JAVA" || -z "$CLASSPATH_DECODE" ) ]]; then
+    echo "[$mode] SKIP: no JVM or no rtfuse_lcmtypes.jar (javac/jar/lcm.jar missing at configure time)"
+    exit $SKIP
+  fi
+  unshare_cmd=(unshare -n)
+  if ! err=$(unshare -n true 2>&1); then
+    # Not root: a user namespace gives the same isolation where it is allowed.
+    if [[ $(id -u) -ne 0 ]] && unshare -r -n true 2>/dev/null; then
+      unshare_cmd=(unshare -r -n)
+      say "unshare -n refused ($err); using a user namespace (unshare -r -n)"
+    elif [[ "${RTFUSE_SKIP_NETNS:-}" == "1" ]]; then
+      echo "[$mode] SKIP: cannot create a private network namespace (unshare -n: $err); RTFUSE_SKIP_NETNS=1"
+      exit $SKIP
+    else
+      die "cannot create a private network namespace: 'unshare -n true' failed: $err
+  The system tests send real UDP multicast and must never do it on the host's
+  network. Run them as root (or in a container with CAP_SYS_ADMIN), or set
+  RTFUSE_SKIP_NETNS=1 to skip them."
+    fi
+  fi
+  rm -rf "$outdir"
+  mkdir -p "$outdir"
+  RTFUSE_SYSTEM_TEST_IN_NETNS=1 exec "${unshare_cmd[@]}" -- "$BASH" "$0" "$mode" "$outdir" "$rtfused" \
+    PYTHON="$PYTHON" CHECK="$CHECK" TOOLS_DIR="$TOOLS_DIR" JAVA="$JAVA" CLASSPATH_DECODE="$CLASSPATH_DECODE" \
+    PROBE="$PROBE" PROBE_SELFTEST="$PROBE_SELFTEST"
+fi
+
+# ---------------------------------------------------------------------------
+# Inside the private network namespace.
+pids=()
+cleanup() {
+  local p
+  for p in "${pids[@]}"; do kill -KILL "$p" 2>/dev/null || true; done
+}
+trap cleanup EXIT
+
+ip link set lo up || die "ip link set lo up failed"
+ip route add 224.0.0.0/4 dev lo || die "ip route add 224.0.0.0/4 dev lo failed"
+# Safety: this namespace must hold nothing but lo, so nothing can leave it.
+links=$(ip -o link show | awk -F': ' '{print $2}' | tr '\n' ' ')
+[[ "$links" == "lo " ]] || die "not a private network namespace (links: $links); refusing to send multicast"
+say "private network namespace: links [${links% }], route $(ip route show 224.0.0.0/4)"
+
+export RTFUSE_TOOLS_DIR="$TOOLS_DIR"
+
+show() { # show FILE TITLE: a file's content, indented, for the CTest log
+  [[ -s "$1" ]] || return 0
+  echo "--- $2 ---"
+  sed 's/^/  /' "$1"
+}
+
+# record LOG: lcm-logger for ~5 s while rtfused runs 6 s; sets rtfused_rc
+record() {
+  local log=$1
+  command -v lcm-logger >/dev/null || die "lcm-logger not found (package liblcm-bin)"
+  lcm-logger -q -f --lcm-url="$URL" "$log" >"$outdir/lcm-logger.out" 2>&1 &
+  local logger=$!
+  pids+=("$logger")
+  sleep 0.5
+  kill -0 "$logger" 2>/dev/null || { show "$outdir/lcm-logger.out" lcm-logger; die "lcm-logger did not start"; }
+
+  timeout -k 5 25 "$rtfused" --duration 6 --lcm-url "$URL" \
+    >"$outdir/rtfused.stdout" 2>"$outdir/rtfused.stderr" &
+  local daemon=$!
+  pids+=("$daemon")
+  sleep 5
+  kill -INT "$logger" 2>/dev/null || true
+  local logger_rc=0
+  wait "$logger" || logger_rc=$?
+  rtfused_rc=0
+  wait "$daemon" || rtfused_rc=$?
+  show "$outdir/rtfused.stderr" "rtfused stderr"
+  show "$outdir/rtfused.stdout" "rtfused stdout"
+  show "$outdir/lcm-logger.out" "lcm-logger"
+  say "rtfused exit status $rtfused_rc, lcm-logger exit status $logger_rc"
+  [[ $rtfused_rc -ne 124 && $rtfused_rc -ne 137 ]] || die "rtfused --duration 6 did not stop within 25 s"
+  [[ -f "$log" ]] || die "lcm-logger wrote no log"
+}
+
+check_log() {
+  "$PYTHON" "$CHECK" log "$1" --rtfused-rc "$rtfused_rc" --rtfused-stdout "$outdir/rtfused.stdout" \
+    --expect rtfuse/odometry:101 --expect rtfuse/pose:101 --expect rtfuse/tf:101 \
+    --expect rtfuse/state:21 --expect rtfuse/diagnostics:3 \
+    --rate rtfuse/odometry:35:65 --rate rtfuse/pose:35:65 --rate rtfuse/tf:35:65 --rate rtfuse/state:7:13
+}
+
+case "$mode" in
+  udp_multicast)
+    record "$outdir/udp_multicast.lcm"
+    check_log "$outdir/udp_multicast.lcm" || die "the recording over UDP multicast failed its checks"
+    ;;
+
+  jvm_decode)
+    record "$outdir/jvm_decode.lcm"
+    check_log "$outdir/jvm_decode.lcm" >"$outdir/check_log.out" 2>&1 || {
+      cat "$outdir/check_log.out"
+      die "the recording failed its checks; nothing to decode"
+    }
+    expect=(rtfuse/odometry=rtfuse.odometry_t:101
+            rtfuse/pose=rtfuse.pose_with_covariance_stamped_t:101
+            rtfuse/tf=rtfuse.tf_t:101
+            rtfuse/state=rtfuse.filter_state_t:21
+            rtfuse/diagnostics=rtfuse.diagnostics_t:3)
+    decode() { CLASSPATH= "$JAVA" -Djava.awt.headless=true -cp "$CLASSPATH_DECODE" DecodeAll "$@"; }
+    say "decoding every rtfuse/* event with the generated Java classes"
+    decode "$outdir/jvm_decode.lcm" "${expect[@]}" || die "the JVM could not decode the log"
+    # Negative controls: the decoder must reject a damaged log.
+    for kind in fingerprint truncate; do
+      "$PYTHON" "$CHECK" corrupt "$outdir/jvm_decode.lcm" "$outdir/damaged-$kind.lcm" "$kind" >/dev/null ||
+        die "cannot write the damaged log ($kind)"
+      if decode "$outdir/damaged-$kind.lcm" "${expect[@]}" >"$outdir/damaged-$kind.out" 2>&1; then
+        cat "$outdir/damaged-$kind.out"
+        die "DecodeAll accepted a log with a damaged event ($kind)"
+      fi
+      say "negative control ($kind): rejected: $(grep -m1 '^ERROR' "$outdir/damaged-$kind.out" || true)"
+    done
+    ;;
+
+  zero_alloc)
+    [[ -f "$PROBE" ]] || die "alloc probe not found: $PROBE"
+    say "probe self-test: a known allocation pattern must be seen"
+    if ! RTFUSE_ALLOC_REPORT="$outdir/selftest.report" LD_PRELOAD="$PROBE" timeout 20 "$PROBE_SELFTEST" ||
+       ! "$PYTHON" "$CHECK" alloc "$outdir/selftest.report" --selftest >"$outdir/selftest.out" 2>&1; then
+      show "$outdir/selftest.out" "self-test"
+      show "$outdir/selftest.report" "self-test report"
+      die "the allocation probe's self-test failed: its verdict on rtfused would mean nothing"
+    fi
+    say "probe self-test OK"
+    rc=0
+    RTFUSE_ALLOC_REPORT="$outdir/rtfused.report" LD_PRELOAD="$PROBE" \
+      timeout -k 5 25 "$rtfused" --duration 5 --quiet \
+      >"$outdir/rtfused.stdout" 2>"$outdir/rtfused.stderr" || rc=$?
+    show "$outdir/rtfused.stderr" "rtfused stderr"
+    show "$outdir/rtfused.stdout" "rtfused stdout"
+    say "rtfused exit status $rc"
+    "$PYTHON" "$CHECK" alloc "$outdir/rtfused.report" --rtfused-stdout "$outdir/rtfused.stdout" || {
+      echo "(raw report: $outdir/rtfused.report)"
+      die "rtfused allocates on the heap in steady state"
+    }
+    [[ $rc -eq 0 ]] || die "rtfused under the allocation probe exited with status $rc"
+    ;;
+esac
+say "PASS"
