@@ -137,7 +137,91 @@ def check_bad_messages(tmp):
     assert err < TOLERANCE
 
 
-CHECKS = {"bag_parity": check_bag_parity, "deterministic": check_deterministic,
+def quat_mul(a, b):
+    ax, ay, az, aw = a
+    bx, by, bz, bw = b
+    return (aw * bx + ax * bw + ay * bz - az * by,
+            aw * by - ax * bz + ay * bw + az * bx,
+            aw * bz + ax * by - ay * bx + az * bw,
+            aw * bw - ax * bx - ay * by - az * bz)
+
+
+def quat_from_rpy(roll, pitch, yaw):
+    # tf2's setRPY: fixed axes, R = Rz(yaw) Ry(pitch) Rx(roll)
+    cr, sr = math.cos(roll / 2), math.sin(roll / 2)
+    cp, sp = math.cos(pitch / 2), math.sin(pitch / 2)
+    cy, sy = math.cos(yaw / 2), math.sin(yaw / 2)
+    return (sr * cp * cy - cr * sp * sy, cr * sp * cy + sr * cp * sy,
+            cr * cp * sy - sr * sp * cy, cr * cp * cy + sr * sp * sy)
+
+
+def quat_matrix(q):
+    x, y, z, w = q
+    return [[1 - 2 * (y * y + z * z), 2 * (x * y - z * w), 2 * (x * z + y * w)],
+            [2 * (x * y + z * w), 1 - 2 * (x * x + z * z), 2 * (y * z - x * w)],
+            [2 * (x * z - y * w), 2 * (y * z + x * w), 1 - 2 * (x * x + y * y)]]
+
+
+def check_rotated_imu(tmp):
+    """The Jackal's IMU re-expressed as if mounted upside down and turned 90
+    degrees (frame imu_link); with that mounting given as --static-tf, the
+    replay must end where the correctly mounted one does, no code changes."""
+    from rtfuse_tools import lcm_log
+    from rtfuse_tools.lcmtypes_path import import_lcmtypes
+    import_lcmtypes()
+    from rtfuse import imu_t
+    log, cfg = prepare(tmp)
+    p = replay(cfg, log)
+    assert p.returncode == 0, p.stderr
+    straight = last_json(p)
+
+    roll, pitch, yaw = math.pi, 0.0, math.pi / 2
+    base_q_imu = quat_from_rpy(roll, pitch, yaw)
+    r_bi = quat_matrix(base_q_imu)
+    r_ib = [[r_bi[j][i] for j in range(3)] for i in range(3)]  # transpose
+
+    def rot(v):
+        return [sum(r_ib[i][k] * v[k] for k in range(3)) for i in range(3)]
+
+    def rot_cov(c):  # R C R'
+        m = [[c[3 * i + j] for j in range(3)] for i in range(3)]
+        rc = [[sum(r_ib[i][k] * m[k][j] for k in range(3)) for j in range(3)] for i in range(3)]
+        out = [[sum(rc[i][k] * r_ib[j][k] for k in range(3)) for j in range(3)] for i in range(3)]
+        return [out[i][j] for i in range(3) for j in range(3)]
+
+    out = os.path.join(tmp, "rotated.lcm")
+    with lcm_log.LogWriter(out) as w:
+        for ev in lcm_log.read_events(log):
+            data = ev.data
+            if ev.channel == "/imu/data":
+                m = imu_t.decode(data)
+                m.header.frame_id = "imu_link"
+                o = m.orientation
+                q = quat_mul((o.x, o.y, o.z, o.w), base_q_imu)  # world_q_imu = world_q_base * base_q_imu
+                o.x, o.y, o.z, o.w = q
+                for vec in (m.angular_velocity, m.linear_acceleration):
+                    vec.x, vec.y, vec.z = rot((vec.x, vec.y, vec.z))
+                m.orientation_covariance = rot_cov(m.orientation_covariance)
+                m.angular_velocity_covariance = rot_cov(m.angular_velocity_covariance)
+                m.linear_acceleration_covariance = rot_cov(m.linear_acceleration_covariance)
+                data = m.encode()
+            w.write(ev.channel, data, ev.timestamp)
+    cfg_rot = os.path.join(tmp, "rotated.toml")
+    tf = f"0.1 0 0.2 {yaw} {pitch} {roll} base_link imu_link"  # tf2 order: x y z yaw pitch roll
+    p = run(["/usr/bin/python3", os.path.join(SRC, "tools", "rl_params_to_toml.py"), PARAMS, "-o", cfg_rot,
+             "--static-tf", tf])
+    assert p.returncode == 0, p.stderr
+    p = replay(cfg_rot, out)
+    assert p.returncode == 0, p.stderr
+    rotated = last_json(p)
+    d = math.dist((rotated["x"], rotated["y"], rotated["z"]), (straight["x"], straight["y"], straight["z"]))
+    print(f"rotated IMU: final ({rotated['x']:.4f}, {rotated['y']:.4f}, {rotated['z']:.4f}), "
+          f"{d * 1000:.3f} mm from the correctly mounted run")
+    assert rotated["sensors"]["imu0"]["accepted"] == straight["sensors"]["imu0"]["accepted"]
+    assert d < 1e-3, d
+
+
+CHECKS = {"rotated_imu": check_rotated_imu, "bag_parity": check_bag_parity, "deterministic": check_deterministic,
           "bad_logs": check_bad_logs, "bad_messages": check_bad_messages}
 
 if __name__ == "__main__":
