@@ -4,7 +4,7 @@
 set -euo pipefail
 
 packages=(
-  g++ cmake ninja-build make
+  gcc g++ cmake ninja-build make
   libeigen3-dev
   liblcm-dev liblcm-bin liblcm-java libjchart2d-java
   libtomlplusplus-dev libcli11-dev
