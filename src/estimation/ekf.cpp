@@ -127,42 +127,22 @@ CorrectResult Ekf::correct(const Measurement& m) noexcept {
 
 namespace {
 
-// Inverse of a symmetric positive-definite N x N matrix through its Cholesky
-// factor, in plain fixed-size loops: at these sizes Eigen's solve() goes
-// through its blocked triangular-solve kernels, whose packing costs more than
-// the arithmetic. Returns false when s is not positive definite.
+// Cholesky factor S = L L' of a symmetric positive-definite N x N matrix in
+// plain fixed-size loops (Eigen's LLT dispatches to blocked kernels whose set-up
+// dominates at these sizes). Stores 1/L(j,j) so later steps never divide.
+// Returns false when s is not positive definite.
 template <int N>
-bool invert_spd(const Eigen::Matrix<double, N, N>& s, Eigen::Matrix<double, N, N>* inverse) noexcept {
-  double l[N][N] = {};
+bool cholesky(const Eigen::Matrix<double, N, N>& s, double (&l)[N][N], double (&d_inv)[N]) noexcept {
   for (int j = 0; j < N; ++j) {
     double d = s(j, j);
     for (int k = 0; k < j; ++k) d -= l[j][k] * l[j][k];
-    if (!(d > 0.0)) return false;
+    if (!(d > 0.0) || !std::isfinite(d)) return false;
     l[j][j] = std::sqrt(d);
-    const double inv = 1.0 / l[j][j];
+    d_inv[j] = 1.0 / l[j][j];
     for (int i = j + 1; i < N; ++i) {
       double v = s(i, j);
       for (int k = 0; k < j; ++k) v -= l[i][k] * l[j][k];
-      l[i][j] = v * inv;
-    }
-  }
-  // L^-1 by forward substitution (lower triangular).
-  double li[N][N] = {};
-  for (int j = 0; j < N; ++j) {
-    li[j][j] = 1.0 / l[j][j];
-    for (int i = j + 1; i < N; ++i) {
-      double v = 0.0;
-      for (int k = j; k < i; ++k) v -= l[i][k] * li[k][j];
-      li[i][j] = v / l[i][i];
-    }
-  }
-  // S^-1 = L^-T L^-1, symmetric: fill both halves from one.
-  for (int i = 0; i < N; ++i) {
-    for (int j = 0; j <= i; ++j) {
-      double v = 0.0;
-      for (int k = i; k < N; ++k) v += li[k][i] * li[k][j];
-      (*inverse)(i, j) = v;
-      (*inverse)(j, i) = v;
+      l[i][j] = v * d_inv[j];
     }
   }
   return true;
@@ -173,20 +153,25 @@ bool invert_spd(const Eigen::Matrix<double, N, N>& s, Eigen::Matrix<double, N, N
 // H is a selection matrix (row a picks state idx[a]), so H P H' and P H' are
 // gathers and no H is ever formed. Dispatching on the update size N keeps
 // every matrix fixed-size (no Eigen::Dynamic, no allocation).
+//
+// With S = L L', everything is done on rows of 16 contiguous doubles (whole
+// SSE2/NEON packets, independent lanes): U' (its rows are columns of the
+// symmetric P), V' = L^-1 U', K' = L^-T V' = S^-1 U', and (K S)' = L V'.
+// No inverse is formed, and the Mahalanobis distance is |L^-1 innovation|^2.
 template <int N>
 CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept {
   using VecN = Eigen::Matrix<double, N, 1>;
   using MatN = Eigen::Matrix<double, N, N>;
-  using MatXN = Eigen::Matrix<double, kStateSize + 1, N>;  // padded rows
+  using RowsN = Eigen::Matrix<double, N, kStateSize + 1, Eigen::RowMajor>;
 
   VecN innovation;
   MatN s;
-  MatXN u;  // P H'
+  RowsN ut;  // U' = H P
   for (int a = 0; a < N; ++a) {
     const int ia = idx[a];
     innovation(a) = m.z(ia) - x_(ia);
     if (is_angle_index(ia)) innovation(a) = wrap_angle(innovation(a));
-    u.col(a) = p_.col(ia);
+    ut.row(a) = p_.col(ia).transpose();
     for (int b = 0; b < N; ++b) s(a, b) = m.covariance(ia, idx[b]) + p_(ia, idx[b]);
     // As robot_localization: negative variances are taken as their magnitude
     // and near-zero ones floored, so a "perfect" sensor cannot make S singular.
@@ -195,13 +180,20 @@ CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept 
   }
 
   CorrectResult result;
-  MatN s_inv;
-  if (!invert_spd<N>(s, &s_inv)) {
+  double l[N][N] = {};
+  double d_inv[N];
+  if (!cholesky<N>(s, l, d_inv)) {
     result.outcome = CorrectOutcome::kRejectedNumeric;
     return result;
   }
-  const VecN s_inv_innovation = s_inv.lazyProduct(innovation);
-  result.squared_mahalanobis = innovation.dot(s_inv_innovation);
+  // y = L^-1 innovation; squared Mahalanobis distance = y'y.
+  VecN y;
+  for (int k = 0; k < N; ++k) {
+    double v = innovation(k);
+    for (int j = 0; j < k; ++j) v -= l[k][j] * y(j);
+    y(k) = v * d_inv[k];
+  }
+  result.squared_mahalanobis = y.squaredNorm();
   if (!std::isfinite(result.squared_mahalanobis) ||
       result.squared_mahalanobis >= m.mahalanobis_threshold * m.mahalanobis_threshold) {
     result.outcome = std::isfinite(result.squared_mahalanobis)
@@ -210,15 +202,32 @@ CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept 
     return result;
   }
 
-  // K = P H' S^-1.
-  const MatXN k = u.lazyProduct(s_inv);
-  const StateVector x_new = x_ + u.lazyProduct(s_inv_innovation).template head<kStateSize>();
+  RowsN vt;  // V' = L^-1 U'
+  for (int k = 0; k < N; ++k) {
+    vt.row(k) = ut.row(k);
+    for (int j = 0; j < k; ++j) vt.row(k) -= l[k][j] * vt.row(j);
+    vt.row(k) *= d_inv[k];
+  }
+  RowsN kt;  // K' = L^-T V'
+  for (int k = N - 1; k >= 0; --k) {
+    kt.row(k) = vt.row(k);
+    for (int j = k + 1; j < N; ++j) kt.row(k) -= l[j][k] * kt.row(j);
+    kt.row(k) *= d_inv[k];
+  }
+  // x += K innovation = V y.
+  const StateVector x_new = x_ + (vt.transpose() * y).template head<kStateSize>();
+
   // Joseph form (I-KH) P (I-KH)' + K R K', expanded for a selection H:
   //   P - K U' - U K' + K S K'  with U = P H', S = H P H' + R.
   // It equals the product form for any gain K (no optimality assumed) and is
-  // symmetric by construction as P + B + B' with B = (K S / 2 - U) K'.
-  const MatXN w = 0.5 * k.lazyProduct(s) - u;
-  const PaddedMatrix b = w.lazyProduct(k.transpose());
+  // symmetric by construction as P + B + B' with B = W K', W = K S / 2 - U;
+  // here W' = (L V') / 2 - U'.
+  RowsN wt;
+  for (int k = 0; k < N; ++k) {
+    wt.row(k) = -ut.row(k);
+    for (int j = 0; j <= k; ++j) wt.row(k) += (0.5 * l[k][j]) * vt.row(j);
+  }
+  const PaddedMatrix b = wt.transpose().lazyProduct(kt);
   const PaddedMatrix p_new = p_ + b + b.transpose();
 
   if (!x_new.allFinite() || !p_new.allFinite()) {
