@@ -3,6 +3,7 @@
 // translation unit per test executable through alloc_counter.cpp.
 #include <atomic>
 #include <cstddef>
+#include <cstdint>
 
 namespace rtfuse::test {
 
@@ -10,6 +11,10 @@ struct AllocCounter {
   static std::atomic<bool> armed;
   static std::atomic<std::size_t> count;
 };
+
+// Every operator new since the program started, armed or not: tests compare
+// it before and after the calls they check.
+std::uint64_t allocation_count() noexcept;
 
 // Counts allocations made between construction and count().
 class AllocScope {

@@ -9,9 +9,14 @@
 namespace rtfuse::test {
 std::atomic<bool> AllocCounter::armed{false};
 std::atomic<std::size_t> AllocCounter::count{0};
+namespace {
+std::atomic<std::uint64_t> g_total_allocations{0};
+}
+std::uint64_t allocation_count() noexcept { return g_total_allocations.load(std::memory_order_relaxed); }
 }  // namespace rtfuse::test
 
 static void* rtfuse_counted_alloc(std::size_t n, std::size_t align) {
+  rtfuse::test::g_total_allocations.fetch_add(1, std::memory_order_relaxed);
   if (rtfuse::test::AllocCounter::armed.load(std::memory_order_relaxed)) {
     rtfuse::test::AllocCounter::count.fetch_add(1, std::memory_order_relaxed);
   }

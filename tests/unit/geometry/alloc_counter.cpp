@@ -1,3 +1,2 @@
-// The same counting operator new as the core tests, compiled into this
-// executable too (each test executable needs its own replacement).
-#include "unit/core/alloc_counter.cpp"
+// The counting operator new shared by every test executable.
+#include "support/alloc_counter_impl.hpp"

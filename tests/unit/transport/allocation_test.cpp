@@ -1,5 +1,5 @@
-// Steady-state allocation checks. Replacing the global operator new here
-// replaces it for the whole test executable; it only counts while armed.
+// Steady-state allocation checks, with the counting operator new of
+// tests/support (alloc_counter.cpp); it only counts while armed.
 #include <gtest/gtest.h>
 #include <unistd.h>
 
@@ -11,79 +11,33 @@
 #include <string>
 #include <vector>
 
+#include "support/alloc_counter.hpp"
 #include "transport/encode_buffer.hpp"
 #include "transport/event_log.hpp"
 #include "transport/sample_decoder.hpp"
 
 namespace {
 
-std::atomic<bool> g_armed{false};
-std::atomic<long> g_allocations{0};
-
-void* counted_alloc(std::size_t size, std::size_t align) {
-  if (g_armed.load(std::memory_order_relaxed))
-    g_allocations.fetch_add(1, std::memory_order_relaxed);
-  if (size == 0) size = 1;
-  void* p = nullptr;
-  if (align <= alignof(std::max_align_t)) {
-    p = std::malloc(size);
-  } else if (posix_memalign(&p, align, size) != 0) {
-    p = nullptr;
-  }
-  if (p == nullptr) throw std::bad_alloc();
-  return p;
-}
-
-// Out of line so that GCC, seeing operator new paired with free() after
-// inlining, does not raise -Wmismatched-new-delete at some optimisation levels.
-[[gnu::noinline]] void counted_free(void* p) noexcept { std::free(p); }
-
-// Counts allocations made inside f.
+// Counts allocations made inside f, with Eigen's own check armed as well.
 template <class F>
 long allocations_in(F&& f) {
-  g_allocations = 0;
 #ifdef EIGEN_RUNTIME_NO_MALLOC
   Eigen::internal::set_is_malloc_allowed(false);
 #endif
-  g_armed = true;
-  f();
-  g_armed = false;
+  long n = 0;
+  {
+    rtfuse::test::AllocScope scope;
+    f();
+    n = static_cast<long>(scope.count());
+  }
 #ifdef EIGEN_RUNTIME_NO_MALLOC
   Eigen::internal::set_is_malloc_allowed(true);
 #endif
-  return g_allocations.load();
+  return n;
 }
 
 }  // namespace
 
-void* operator new(std::size_t size) { return counted_alloc(size, 0); }
-void* operator new[](std::size_t size) { return counted_alloc(size, 0); }
-void* operator new(std::size_t size, std::align_val_t a) {
-  return counted_alloc(size, static_cast<std::size_t>(a));
-}
-void* operator new[](std::size_t size, std::align_val_t a) {
-  return counted_alloc(size, static_cast<std::size_t>(a));
-}
-void* operator new(std::size_t size, const std::nothrow_t&) noexcept {
-  try {
-    return counted_alloc(size, 0);
-  } catch (...) {
-    return nullptr;
-  }
-}
-void* operator new[](std::size_t size, const std::nothrow_t& t) noexcept {
-  return operator new(size, t);
-}
-void operator delete(void* p, const std::nothrow_t&) noexcept { counted_free(p); }
-void operator delete[](void* p, const std::nothrow_t&) noexcept { counted_free(p); }
-void operator delete(void* p) noexcept { counted_free(p); }
-void operator delete[](void* p) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t) noexcept { counted_free(p); }
-void operator delete(void* p, std::align_val_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::align_val_t) noexcept { counted_free(p); }
-void operator delete(void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
-void operator delete[](void* p, std::size_t, std::align_val_t) noexcept { counted_free(p); }
 
 namespace rtfuse::transport {
 namespace {
@@ -96,7 +50,12 @@ std::vector<std::uint8_t> bytes_of(const Msg& m) {
 }
 
 TEST(Allocation, CounterSeesAllocations) {
-  EXPECT_GE(allocations_in([] { delete new int(3); }), 1);
+  // volatile: a new/delete pair the compiler can see through may be elided.
+  EXPECT_GE(allocations_in([] {
+              int* volatile p = new int(3);
+              delete p;
+            }),
+            1);
 }
 
 TEST(Allocation, DecoderDoesNotAllocateInSteadyState) {
