@@ -46,7 +46,12 @@ int main(int argc, char** argv) {
   app.add_option("-l,--log", log_path, "input LCM log")->required();
   app.add_option("-o,--out", out_path, "write the published channels to this LCM log");
   app.add_flag("-q,--quiet", quiet, "no progress line");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help is a ParseError with exit code 0; every real error is a usage error (2).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
 
   const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_file(config_path);
   if (!loaded.config) {

@@ -53,10 +53,20 @@ int main(int argc, char** argv) {
   bool quiet = false;
   app.add_option("-c,--config", config_path, "TOML config (default: the embedded config/sim.toml)");
   app.add_option("-d,--duration", duration, "stop after this many seconds (0: run until SIGINT/SIGTERM)")
-      ->check(CLI::NonNegativeNumber);
+      ->check([](const std::string& v) {
+        double d = -1.0;
+        return CLI::detail::lexical_cast(v, d) && d >= 0.0 && std::isfinite(d)
+                   ? std::string()
+                   : "must be a number of seconds >= 0, got '" + v + "'";
+      });
   app.add_option("--lcm-url", lcm_url, "override [lcm] url");
   app.add_flag("-q,--quiet", quiet, "no live status line");
-  CLI11_PARSE(app, argc, argv);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    // --help is a ParseError with exit code 0; every real error is a usage error (2).
+    return app.exit(e) == 0 ? 0 : 2;
+  }
 
   rtfuse::ConfigLoadResult loaded =
       config_path.empty()
