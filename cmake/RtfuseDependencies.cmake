@@ -22,9 +22,9 @@ else()
 endif()
 
 # lcm-gen and javac are host tools, also when cross-compiling.
-find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED)
-find_program(JAVAC_EXECUTABLE javac)
-find_program(JAR_EXECUTABLE jar)
+find_program(LCM_GEN_EXECUTABLE lcm-gen REQUIRED NO_CMAKE_FIND_ROOT_PATH)
+find_program(JAVAC_EXECUTABLE javac NO_CMAKE_FIND_ROOT_PATH)
+find_program(JAR_EXECUTABLE jar NO_CMAKE_FIND_ROOT_PATH)
 find_file(LCM_JAR lcm.jar PATHS /usr/share/java /usr/local/share/java NO_CMAKE_FIND_ROOT_PATH)
 
 # toml++ (header-only in use; the Debian package also ships a compiled lib)
