@@ -44,3 +44,18 @@ if(NOT TARGET CLI11::CLI11)
   add_library(CLI11::CLI11 INTERFACE IMPORTED)
   target_include_directories(CLI11::CLI11 INTERFACE ${CLI11_INCLUDE_DIR})
 endif()
+
+# libgpiod v1 (1.6 in Debian 12, the API Jetson images ship). The v2 API
+# renamed most calls; refuse it explicitly rather than fail to compile later.
+find_path(GPIOD_INCLUDE_DIR gpiod.h)
+find_library(GPIOD_LIBRARY NAMES gpiod)
+if(NOT GPIOD_INCLUDE_DIR OR NOT GPIOD_LIBRARY)
+  message(FATAL_ERROR "libgpiod not found: install libgpiod-dev (v1.6)")
+endif()
+file(STRINGS ${GPIOD_INCLUDE_DIR}/gpiod.h gpiod_v1_marker REGEX "gpiod_line_request_rising_edge_events")
+if(NOT gpiod_v1_marker)
+  message(FATAL_ERROR "${GPIOD_INCLUDE_DIR}/gpiod.h is not the libgpiod v1 API (need 1.x, e.g. Debian 12's libgpiod-dev 1.6)")
+endif()
+add_library(rtfuse_gpiod INTERFACE)
+target_include_directories(rtfuse_gpiod SYSTEM INTERFACE ${GPIOD_INCLUDE_DIR})
+target_link_libraries(rtfuse_gpiod INTERFACE ${GPIOD_LIBRARY})

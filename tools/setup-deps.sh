@@ -12,7 +12,7 @@ packages=(
   default-jdk-headless
   python3 python3-rosbag python3-yaml
   iproute2 util-linux
-  linux-libc-dev
+  linux-libc-dev libgpiod-dev
 )
 
 missing=()
