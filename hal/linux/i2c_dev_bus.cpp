@@ -1,0 +1,209 @@
+#include "hal/linux/i2c_dev_bus.hpp"
+
+#include <fcntl.h>
+#include <linux/i2c-dev.h>
+#include <linux/i2c.h>
+#include <sys/ioctl.h>
+#include <unistd.h>
+
+#include <cerrno>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <utility>
+
+namespace rtfuse::hal {
+namespace {
+
+// strerror() may format unknown codes into a shared buffer; strerror_r does
+// not allocate. glibc picks the GNU or the XSI flavour depending on feature
+// macros, the overloads accept either.
+[[maybe_unused]] const char* errtext(int rc, const char* buf) noexcept { return rc == 0 ? buf : "unknown error"; }
+[[maybe_unused]] const char* errtext(const char* rc, const char*) noexcept { return rc; }
+
+const char* error_text(int err, char* buf, std::size_t size) noexcept {
+  return errtext(strerror_r(err, buf, size), buf);
+}
+
+bool all_digits(const std::string& s) {
+  if (s.empty()) return false;
+  for (char c : s) {
+    if (c < '0' || c > '9') return false;
+  }
+  return true;
+}
+
+HalStatus map_errno(int err) noexcept {
+  switch (err) {
+    case ENXIO:
+    case EREMOTEIO: return HalStatus::kNack;
+    case ETIMEDOUT: return HalStatus::kTimeout;
+    case EIO:
+    case EAGAIN: return HalStatus::kBusError;  // EAGAIN from an adapter: arbitration lost
+    case ENODEV: return HalStatus::kClosed;
+    default: return HalStatus::kIoError;
+  }
+}
+
+// A NACK can be a device busy with an internal write cycle, a bus error a
+// glitch or a lost arbitration: both are worth another try. A timeout already
+// cost the adapter's full timeout, and the rest will not get better.
+bool retryable(HalStatus s) noexcept { return s == HalStatus::kNack || s == HalStatus::kBusError; }
+
+}  // namespace
+
+int I2cDevBus::system_ioctl(int fd, unsigned long request, void* arg) noexcept { return ::ioctl(fd, request, arg); }
+
+std::string I2cDevBus::device_path(const std::string& path_or_number) {
+  if (all_digits(path_or_number)) return "/dev/i2c-" + path_or_number;
+  if (path_or_number.rfind("i2c-", 0) == 0) return "/dev/" + path_or_number;
+  return path_or_number;
+}
+
+std::string I2cDevBus::describe_open_failure(const std::string& path, int err) {
+  char buf[128];
+  std::string msg = "cannot open I2C bus " + path + ": " + error_text(err, buf, sizeof buf);
+  switch (err) {
+    case ENOENT:
+      msg += "; no " + path +
+             ": load the i2c-dev module (modprobe i2c-dev) and check the bus number with i2cdetect -l";
+      break;
+    case EACCES:
+    case EPERM:
+      msg += "; add the user to group i2c (usermod -aG i2c $USER, then log in again) or add a udev rule "
+             "giving that group access to " +
+             path;
+      break;
+    default: break;
+  }
+  return msg;
+}
+
+bool I2cDevBus::check_adapter(int fd, const std::string& path, IoctlFn ioctl_fn, std::string* error) {
+  unsigned long funcs = 0;
+  if (ioctl_fn(fd, I2C_FUNCS, &funcs) < 0) {
+    const int err = errno;
+    char buf[128];
+    if (error) {
+      *error = path + " is not an I2C adapter (I2C_FUNCS failed: " + error_text(err, buf, sizeof buf) +
+               "); pass an i2c-dev node such as /dev/i2c-1 (list buses with i2cdetect -l)";
+    }
+    return false;
+  }
+  if ((funcs & I2C_FUNC_I2C) == 0) {
+    if (error) {
+      *error = path +
+               " supports SMBus only, not the combined I2C transfers (I2C_RDWR) this backend needs; "
+               "use a bus whose adapter reports I2C in i2cdetect -F";
+    }
+    return false;
+  }
+  return true;
+}
+
+std::unique_ptr<I2cDevBus> I2cDevBus::open(const std::string& path_or_number, I2cRetryPolicy policy,
+                                           std::string* error) {
+  const std::string path = device_path(path_or_number);
+  const int fd = ::open(path.c_str(), O_RDWR | O_CLOEXEC);
+  if (fd < 0) {
+    const int err = errno;
+    if (error) *error = describe_open_failure(path, err);
+    return nullptr;
+  }
+  if (!check_adapter(fd, path, &system_ioctl, error)) {
+    ::close(fd);
+    return nullptr;
+  }
+  return adopt(fd, path, policy, &system_ioctl);
+}
+
+std::unique_ptr<I2cDevBus> I2cDevBus::adopt(int fd, std::string name, I2cRetryPolicy policy, IoctlFn ioctl_fn) {
+  return std::unique_ptr<I2cDevBus>(new I2cDevBus(fd, std::move(name), policy, ioctl_fn ? ioctl_fn : &system_ioctl));
+}
+
+I2cDevBus::I2cDevBus(int fd, std::string name, I2cRetryPolicy policy, IoctlFn ioctl_fn)
+    : fd_(fd), name_(std::move(name)), policy_(policy), ioctl_(ioctl_fn) {
+  if (policy_.attempts < 1) policy_.attempts = 1;
+}
+
+I2cDevBus::~I2cDevBus() {
+  if (fd_ >= 0) ::close(fd_);
+}
+
+void I2cDevBus::set_error(const char* fmt, ...) noexcept {
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(last_error_, sizeof last_error_, fmt, ap);
+  va_end(ap);
+}
+
+HalStatus I2cDevBus::transfer(void* rdwr, unsigned nmsgs, std::uint8_t address, std::uint8_t reg,
+                              const char* op) noexcept {
+  int failures = 0;
+  for (int attempt = 1; attempt <= policy_.attempts; ++attempt) {
+    const int rc = ioctl_(fd_, I2C_RDWR, rdwr);
+    if (rc == static_cast<int>(nmsgs)) {
+      retries_ += failures;
+      return HalStatus::kOk;
+    }
+    if (rc >= 0) {
+      // The adapter stopped part-way without an errno; what the device saw
+      // is unknown, so retrying a write could repeat a side effect.
+      set_error("%s: %s addr 0x%02x reg 0x%02x: short transfer (%d of %u messages)", name_.c_str(), op, address,
+                reg, rc, nmsgs);
+      return HalStatus::kIoError;
+    }
+    const int err = errno;
+    const HalStatus s = map_errno(err);
+    char buf[96];
+    set_error("%s: %s addr 0x%02x reg 0x%02x failed on attempt %d of %d: %s (%s)", name_.c_str(), op, address, reg,
+              attempt, policy_.attempts, error_text(err, buf, sizeof buf), to_string(s));
+    if (!retryable(s)) return s;
+    ++failures;
+    if (attempt == policy_.attempts) return s;
+  }
+  return HalStatus::kIoError;  // unreachable: attempts >= 1
+}
+
+HalStatus I2cDevBus::read_registers(std::uint8_t address, std::uint8_t reg, std::uint8_t* buf, int n) noexcept {
+  if (address > 0x7f) {
+    set_error("%s: read addr 0x%02x reg 0x%02x: not a 7-bit address", name_.c_str(), address, reg);
+    return HalStatus::kIoError;
+  }
+  if (buf == nullptr || n < 1 || n > kMaxRead) {
+    set_error("%s: read addr 0x%02x reg 0x%02x: length %d outside 1..%d", name_.c_str(), address, reg, n,
+              kMaxRead);
+    return HalStatus::kIoError;
+  }
+  std::uint8_t reg_byte = reg;
+  i2c_msg msgs[2];
+  msgs[0].addr = address;
+  msgs[0].flags = 0;
+  msgs[0].len = 1;
+  msgs[0].buf = &reg_byte;
+  msgs[1].addr = address;
+  msgs[1].flags = I2C_M_RD;
+  msgs[1].len = static_cast<__u16>(n);
+  msgs[1].buf = rx_;
+  i2c_rdwr_ioctl_data data{msgs, 2};
+  const HalStatus s = transfer(&data, 2, address, reg, "read");
+  if (s == HalStatus::kOk) std::memcpy(buf, rx_, static_cast<std::size_t>(n));
+  return s;
+}
+
+HalStatus I2cDevBus::write_register(std::uint8_t address, std::uint8_t reg, std::uint8_t value) noexcept {
+  if (address > 0x7f) {
+    set_error("%s: write addr 0x%02x reg 0x%02x: not a 7-bit address", name_.c_str(), address, reg);
+    return HalStatus::kIoError;
+  }
+  std::uint8_t bytes[2] = {reg, value};
+  i2c_msg msg;
+  msg.addr = address;
+  msg.flags = 0;
+  msg.len = 2;
+  msg.buf = bytes;
+  i2c_rdwr_ioctl_data data{&msg, 1};
+  return transfer(&data, 1, address, reg, "write");
+}
+
+}  // namespace rtfuse::hal
