@@ -6,7 +6,7 @@
 
 #include "hal/clock.hpp"
 
-namespace rtfuse::hal {
+namespace rtfuse::hal::mock {
 
 class SimClock final : public Clock {
  public:
@@ -32,4 +32,4 @@ class SimClock final : public Clock {
   static_assert(std::atomic<TimeNs>::is_always_lock_free, "RT path needs lock-free atomics");
 };
 
-}  // namespace rtfuse::hal
+}  // namespace rtfuse::hal::mock

@@ -15,6 +15,7 @@
 
 namespace rtfuse::hal {
 namespace {
+using mock::SimClock;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kSanity = 2 * kNsPerSec;
