@@ -1,4 +1,5 @@
 #include "hal/linux/gpiod_line.hpp"
+#include "hal/linux/errno_text.hpp"
 
 #include <cerrno>
 #include <cstdarg>
@@ -8,14 +9,6 @@
 
 namespace rtfuse::hal {
 namespace {
-
-[[maybe_unused]] const char* errtext(int rc, const char* buf) noexcept { return rc == 0 ? buf : "unknown error"; }
-[[maybe_unused]] const char* errtext(const char* rc, const char*) noexcept { return rc; }
-
-// strerror_r, either flavour: never allocates, unlike building a std::string.
-const char* error_text(int err, char* buf, std::size_t size) noexcept {
-  return errtext(strerror_r(err, buf, size), buf);
-}
 
 constexpr const char kLabelPrefix[] = "label:";
 constexpr std::size_t kLabelPrefixLen = sizeof kLabelPrefix - 1;
@@ -66,12 +59,11 @@ TimeNs gpio_event_stamp_to_monotonic(TimeNs stamp, TimeNs monotonic_now, TimeNs 
 }
 
 std::string describe_gpiod_failure(const std::string& chip, unsigned offset, GpiodStage stage, int err) {
-  char buf[128];
   const char* what = stage == GpiodStage::kChip   ? "cannot open chip"
                      : stage == GpiodStage::kLine ? "cannot get line"
                                                   : "cannot request line for consumer 'rtfuse'";
   std::string msg = "gpio " + chip + " line " + std::to_string(offset) + ": " + what + ": " +
-                    error_text(err, buf, sizeof buf);
+                    ErrnoText(err).text;
   const bool label = is_label(chip);
   const std::string bare = label ? chip.substr(kLabelPrefixLen) : chip;
   switch (stage) {
@@ -165,17 +157,15 @@ HalStatus GpiodEdgeSource::wait_edge(TimeNs timeout_ns, GpioEdge* out) noexcept 
       remaining = left > 0 ? left : 0;
       continue;
     }
-    char buf[96];
     format_into(last_error_, "gpio %s: waiting for an edge failed: %s", name_.c_str(),
-                error_text(err, buf, sizeof buf));
+                ErrnoText(err).text);
     return err == ENODEV ? HalStatus::kClosed : HalStatus::kIoError;
   }
   gpiod_line_event ev{};
   if (ops_.event_read(line_, &ev) < 0) {
     const int err = errno;
-    char buf[96];
     format_into(last_error_, "gpio %s: reading the edge event failed: %s", name_.c_str(),
-                error_text(err, buf, sizeof buf));
+                ErrnoText(err).text);
     return err == ENODEV ? HalStatus::kClosed : HalStatus::kIoError;
   }
   bool rising = false;
@@ -224,9 +214,8 @@ GpiodOutput::~GpiodOutput() {
 HalStatus GpiodOutput::set(bool high) noexcept {
   if (ops_.set_value(line_, high ? 1 : 0) < 0) {
     const int err = errno;
-    char buf[96];
     format_into(last_error_, "gpio %s: setting the line %s failed: %s", name_.c_str(), high ? "high" : "low",
-                error_text(err, buf, sizeof buf));
+                ErrnoText(err).text);
     return err == ENODEV ? HalStatus::kClosed : HalStatus::kIoError;
   }
   return HalStatus::kOk;

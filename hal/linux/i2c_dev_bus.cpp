@@ -1,4 +1,5 @@
 #include "hal/linux/i2c_dev_bus.hpp"
+#include "hal/linux/errno_text.hpp"
 
 #include <fcntl.h>
 #include <linux/i2c-dev.h>
@@ -14,16 +15,6 @@
 
 namespace rtfuse::hal {
 namespace {
-
-// strerror() may format unknown codes into a shared buffer; strerror_r does
-// not allocate. glibc picks the GNU or the XSI flavour depending on feature
-// macros, the overloads accept either.
-[[maybe_unused]] const char* errtext(int rc, const char* buf) noexcept { return rc == 0 ? buf : "unknown error"; }
-[[maybe_unused]] const char* errtext(const char* rc, const char*) noexcept { return rc; }
-
-const char* error_text(int err, char* buf, std::size_t size) noexcept {
-  return errtext(strerror_r(err, buf, size), buf);
-}
 
 bool all_digits(const std::string& s) {
   if (s.empty()) return false;
@@ -61,8 +52,7 @@ std::string I2cDevBus::device_path(const std::string& path_or_number) {
 }
 
 std::string I2cDevBus::describe_open_failure(const std::string& path, int err) {
-  char buf[128];
-  std::string msg = "cannot open I2C bus " + path + ": " + error_text(err, buf, sizeof buf);
+  std::string msg = "cannot open I2C bus " + path + ": " + ErrnoText(err).text;
   switch (err) {
     case ENOENT:
       msg += "; no " + path +
@@ -83,9 +73,8 @@ bool I2cDevBus::check_adapter(int fd, const std::string& path, IoctlFn ioctl_fn,
   unsigned long funcs = 0;
   if (ioctl_fn(fd, I2C_FUNCS, &funcs) < 0) {
     const int err = errno;
-    char buf[128];
     if (error) {
-      *error = path + " is not an I2C adapter (I2C_FUNCS failed: " + error_text(err, buf, sizeof buf) +
+      *error = path + " is not an I2C adapter (I2C_FUNCS failed: " + ErrnoText(err).text +
                "); pass an i2c-dev node such as /dev/i2c-1 (list buses with i2cdetect -l)";
     }
     return false;
@@ -155,9 +144,8 @@ HalStatus I2cDevBus::transfer(void* rdwr, unsigned nmsgs, std::uint8_t address, 
     }
     const int err = errno;
     const HalStatus s = map_errno(err);
-    char buf[96];
     set_error("%s: %s addr 0x%02x reg 0x%02x failed on attempt %d of %d: %s (%s)", name_.c_str(), op, address, reg,
-              attempt, policy_.attempts, error_text(err, buf, sizeof buf), to_string(s));
+              attempt, policy_.attempts, ErrnoText(err).text, to_string(s));
     if (!retryable(s)) return s;
     ++failures;
     if (attempt == policy_.attempts) return s;

@@ -1,4 +1,5 @@
 #include "hal/linux/socketcan_bus.hpp"
+#include "hal/linux/errno_text.hpp"
 
 #include <linux/can.h>
 #include <linux/can/error.h>
@@ -28,20 +29,6 @@ constexpr int kMaxSkipsPerCall = 64;
 // Error classes whose frames move state(); the kernel filters the others out
 // so a bus-error storm (CAN_ERR_BUSERROR "may flood") cannot swamp the queue.
 constexpr can_err_mask_t kHandledErrorClasses = CAN_ERR_BUSOFF | CAN_ERR_CRTL | CAN_ERR_RESTARTED;
-
-// strerror_r is the GNU variant (returns char*) under _GNU_SOURCE, which g++
-// defines, and the XSI one (returns int) elsewhere; overloads accept both so
-// the text never needs the non-thread-safe strerror().
-[[maybe_unused]] inline const char* strerror_result(int rc, const char* buf) noexcept {
-  return rc == 0 ? buf : "unknown error";
-}
-[[maybe_unused]] inline const char* strerror_result(const char* text, const char*) noexcept { return text; }
-
-struct ErrText {
-  char buf[96];
-  explicit ErrText(int err) noexcept : buf{} { text = strerror_result(strerror_r(err, buf, sizeof buf), buf); }
-  const char* text;
-};
 
 TimeNs clock_ns(clockid_t id) noexcept {
   timespec ts{};
@@ -159,7 +146,7 @@ namespace socketcan_detail {
 
 std::string open_error_message(const std::string& ifname, const char* call, int err) {
   char hint_buf[320];
-  const ErrText text(err);
+  const ErrnoText text(err);
   const char* hint = open_hint(call, err, ifname, hint_buf, sizeof hint_buf);
   std::string msg = "CAN interface '" + ifname + "': " + call + " failed: " + text.text;
   msg += " - ";
@@ -257,7 +244,7 @@ std::unique_ptr<SocketCanBus> SocketCanBus::open(const std::string& ifname, cons
 }
 
 void SocketCanBus::set_last_error(const char* what, int err) noexcept {
-  const ErrText text(err);
+  const ErrnoText text(err);
   std::snprintf(last_error_, sizeof last_error_, "%s on %s: %s", what, name_.c_str(), text.text);
 }
 

@@ -83,6 +83,27 @@ void MockI2cBus::note_failure(HalStatus s) noexcept {
   }
 }
 
+template <class Transfer>
+HalStatus MockI2cBus::with_retries(I2cTransferRecord& rec, I2cDevice* dev, Transfer&& transfer) noexcept {
+  HalStatus s = HalStatus::kIoError;
+  int failures = 0;
+  for (int attempt = 1; attempt <= policy_.attempts; ++attempt) {
+    rec.attempts = static_cast<std::uint8_t>(attempt);
+    s = wire_fault();
+    if (s == HalStatus::kOk) s = dev != nullptr ? transfer() : HalStatus::kNack;
+    if (s == HalStatus::kOk) {
+      retries_ += failures;
+      break;
+    }
+    note_failure(s);
+    if (!retryable(s)) break;
+    ++failures;
+  }
+  rec.status = s;
+  log(rec);
+  return s;
+}
+
 HalStatus MockI2cBus::read_registers(std::uint8_t address, std::uint8_t reg, std::uint8_t* buf, int n) noexcept {
   I2cTransferRecord rec;
   rec.address = address;
@@ -97,23 +118,8 @@ HalStatus MockI2cBus::read_registers(std::uint8_t address, std::uint8_t reg, std
   // Reads land here first so a failed transfer never touches the caller's buffer.
   std::uint8_t rx[kMaxRead];
   I2cDevice* dev = find(address);
-  HalStatus s = HalStatus::kIoError;
-  int failures = 0;
-  for (int attempt = 1; attempt <= policy_.attempts; ++attempt) {
-    rec.attempts = static_cast<std::uint8_t>(attempt);
-    s = wire_fault();
-    if (s == HalStatus::kOk) s = dev != nullptr ? dev->i2c_read(reg, rx, n) : HalStatus::kNack;
-    if (s == HalStatus::kOk) {
-      retries_ += failures;
-      std::memcpy(buf, rx, static_cast<std::size_t>(n));
-      break;
-    }
-    note_failure(s);
-    if (!retryable(s)) break;
-    ++failures;
-  }
-  rec.status = s;
-  log(rec);
+  const HalStatus s = with_retries(rec, dev, [&] { return dev->i2c_read(reg, rx, n); });
+  if (s == HalStatus::kOk) std::memcpy(buf, rx, static_cast<std::size_t>(n));
   return s;
 }
 
@@ -131,23 +137,7 @@ HalStatus MockI2cBus::write_register(std::uint8_t address, std::uint8_t reg, std
     return rec.status;
   }
   I2cDevice* dev = find(address);
-  HalStatus s = HalStatus::kIoError;
-  int failures = 0;
-  for (int attempt = 1; attempt <= policy_.attempts; ++attempt) {
-    rec.attempts = static_cast<std::uint8_t>(attempt);
-    s = wire_fault();
-    if (s == HalStatus::kOk) s = dev != nullptr ? dev->i2c_write(reg, value) : HalStatus::kNack;
-    if (s == HalStatus::kOk) {
-      retries_ += failures;
-      break;
-    }
-    note_failure(s);
-    if (!retryable(s)) break;
-    ++failures;
-  }
-  rec.status = s;
-  log(rec);
-  return s;
+  return with_retries(rec, dev, [&] { return dev->i2c_write(reg, value); });
 }
 
 }  // namespace rtfuse::hal::mock

@@ -72,6 +72,10 @@ class MockI2cBus final : public I2cBus {
   HalStatus wire_fault() noexcept;
   void log(const I2cTransferRecord& r) noexcept;
   void note_failure(HalStatus s) noexcept;
+  // One transfer under the retry policy, recorded in rec: wire faults first,
+  // then the device (NACK when absent); NACK and bus errors are retried.
+  template <class Transfer>
+  HalStatus with_retries(I2cTransferRecord& rec, I2cDevice* dev, Transfer&& transfer) noexcept;
 
   I2cRetryPolicy policy_;
   struct Slot {
