@@ -9,6 +9,7 @@
 #include "core/fixed_string.hpp"
 #include "estimation/filter_params.hpp"
 #include "geometry/rigid_transform.hpp"
+#include "runtime/hardware_config.hpp"
 
 namespace rtfuse {
 
@@ -17,9 +18,14 @@ constexpr int kMaxStaticTransforms = 24;
 
 using Name = FixedString<63>;
 
+// Where a sensor's samples come from: decoded LCM messages, or one of the
+// drivers this process runs.
+enum class SensorSource : std::uint8_t { kLcm, kWheelOdometry, kMpu };
+
 struct SensorConfig {
   Name name;        // "odom0", "imu0", ... (robot_localization's sensor names)
-  Name channel;     // LCM channel (the ROS topic, unchanged)
+  Name channel;     // LCM channel (the ROS topic, unchanged); empty for drivers
+  SensorSource source = SensorSource::kLcm;
   est::SensorParams params;
 };
 
@@ -93,6 +99,7 @@ struct RuntimeConfig {
   std::array<StaticTransformConfig, kMaxStaticTransforms> static_transforms{};
   int num_static_transforms = 0;
   SimConfig sim;
+  HardwareConfig hardware;
 };
 
 }  // namespace rtfuse

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "geometry/rotation.hpp"
+#include "runtime/hardware_config_loader.hpp"
 #include "runtime/toml_reader.hpp"
 
 namespace rtfuse {
@@ -238,14 +239,33 @@ struct SensorEntry {
 };
 
 SensorEntry read_sensor(const Section& s) {
-  s.reject_unknown({"name", "type", "channel", "config", "differential", "relative", "queue_size",
+  s.reject_unknown({"name", "type", "channel", "source", "config", "differential", "relative", "queue_size",
                     "pose_rejection_threshold", "twist_rejection_threshold",
                     "linear_acceleration_rejection_threshold", "remove_gravitational_acceleration"});
-  s.require({"name", "type", "channel", "config"});
+  s.require({"name", "type"});
   SensorEntry e;
   est::SensorParams& p = e.cfg.params;
   e.has_name = s.read_name("name", e.cfg.name);
-  e.has_channel = s.read_name("channel", e.cfg.channel);
+  std::string source = "lcm";
+  if (s.read("source", source)) {
+    if (source == "lcm") {
+      e.cfg.source = SensorSource::kLcm;
+    } else if (source == "wheel_odometry") {
+      e.cfg.source = SensorSource::kWheelOdometry;
+    } else if (source == "mpu") {
+      e.cfg.source = SensorSource::kMpu;
+    } else {
+      s.value_error("source", "must be one of lcm, wheel_odometry, mpu, got " + in_quotes(source));
+    }
+  }
+  // A driver-fed sensor has no channel; an LCM one needs it.
+  if (source == "lcm") {
+    s.require({"channel"});
+    e.has_channel = s.read_name("channel", e.cfg.channel);
+  } else if (s.has("channel")) {
+    s.key_error("channel", "not used with source = " + in_quotes(source) + " (the driver feeds this sensor)");
+  }
+  s.require({"config"});
 
   std::optional<est::SensorKind> kind;
   std::string type;
@@ -397,7 +417,8 @@ void read_sim(const Section& s, SimConfig& sim) {
 }
 
 void read_root(const Section& root, RuntimeConfig& cfg) {
-  root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "static_transform", "sim"});
+  root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "static_transform", "sim", "hardware",
+                       "can", "wheel_odometry", "mpu"});
   Diagnostics& d = root.diag();
   read_filter(Section(section_table(root, "filter"), "filter", d), cfg);
   read_realtime(Section(section_table(root, "realtime"), "realtime", d), cfg.realtime);
@@ -406,6 +427,7 @@ void read_root(const Section& root, RuntimeConfig& cfg) {
   read_publish(Section(section_table(root, "publish"), "publish", d), cfg.publish, publish_channels);
   read_sensors(root, cfg, publish_channels);
   read_static_transforms(root, cfg);
+  config::read_hardware(root, cfg);
   read_sim(Section(section_table(root, "sim"), "sim", d), cfg.sim);
 }
 

@@ -18,6 +18,7 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, std::string* 
   if (!rt->lcm_) return nullptr;
   const RuntimeConfig& c = rt->core_->config();
   for (int i = 0; i < c.num_sensors; ++i) {
+    if (c.sensors[i].source != SensorSource::kLcm) continue;
     if (!rt->lcm_->subscribe(c.sensors[i].channel.c_str(), &Runtime::on_lcm, rt->core_.get())) {
       *error = "cannot subscribe to channel '" + std::string(c.sensors[i].channel.view()) + "'";
       return nullptr;

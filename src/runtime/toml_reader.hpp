@@ -136,9 +136,9 @@ void for_each_table(const Section& root, std::string_view k, int max_entries, Fn
   if (!entries) return;
   for (std::size_t i = 0; i < entries->size(); ++i) {
     const toml::node& n = *entries->get(i);
-    const std::string path = std::string(k) + "[" + std::to_string(i) + "]";
+    const std::string path = root.key(k) + "[" + std::to_string(i) + "]";
     if (static_cast<int>(i) == max_entries) {
-      root.diag().add(n.source(), std::string(k),
+      root.diag().add(n.source(), root.key(k),
                       "at most " + std::to_string(max_entries) + " entries, got " + std::to_string(entries->size()));
     }
     if (const auto* t = n.as_table()) {

@@ -1,0 +1,101 @@
+#pragma once
+// The devices the process drives itself, as the TOML describes them
+// ([hardware], [can], [[can.node]], [wheel_odometry], [mpu]). Plain values
+// only; runtime/hardware.cpp turns them into the drivers' own configs.
+// Schema: docs/configuration.md.
+#include <array>
+#include <cstdint>
+#include <string>
+
+#include "core/fixed_string.hpp"
+
+namespace rtfuse {
+
+using HwName = FixedString<63>;  // the same type as config.hpp's Name
+
+// Where the bus primitives come from: the kernel (SocketCAN, i2c-dev,
+// libgpiod), the bus-level simulated robot, or nothing (LCM inputs only).
+enum class HalBackend : std::uint8_t { kNone, kLinux, kSim };
+
+enum class WheelSideConfig : std::uint8_t { kLeft, kRight };
+enum class KinematicsConfig : std::uint8_t { kDifferential, kSkidSteer };
+enum class MpuModelConfig : std::uint8_t { kAuto, kMpu6050, kMpu6500, kMpu9250 };
+enum class AttitudeAlgorithmConfig : std::uint8_t { kMadgwick, kMahony };
+
+constexpr int kMaxWheelNodes = 8;
+
+struct WheelNodeConfig {
+  std::uint8_t node_id = 1;
+  WheelSideConfig side = WheelSideConfig::kLeft;
+  int sign = 1;                      // -1 for the mirrored motor
+  std::uint32_t tpdo_cob_id = 0;     // 0: TPDO1 = 0x180 + node_id
+  std::uint8_t position_offset = 0;  // first byte of the position in the TPDO
+  std::uint8_t position_bits = 32;   // 8, 16, 24 or 32
+  bool position_signed = false;
+};
+
+struct CanConfig {
+  bool enabled = false;
+  HwName interface{"can0"};
+  std::uint32_t sync_cob_id = 0x080;
+  double heartbeat_timeout_s = 0.5;  // 0: no heartbeat supervision
+  int tpdo_timeout_syncs = 5;
+  double stuck_time_s = 0.5;
+  double max_wheel_speed_mps = 5.0;  // beyond this a counter step is a glitch
+  std::array<WheelNodeConfig, kMaxWheelNodes> nodes{};
+  int num_nodes = 0;
+};
+
+struct WheelOdometryConfig {
+  KinematicsConfig kinematics = KinematicsConfig::kDifferential;
+  double track_width_m = 0.5;
+  double wheel_radius_m = 0.1;
+  double counts_per_rev = 4096;
+  double gear_ratio = 1.0;
+  double skid_track_factor = 1.0;
+  double speed_noise_mps = 0.01;
+  double yaw_rate_noise_rad_s = 0.02;
+  double slip = 0.02;              // 1-sigma fractional speed error
+  double lateral_noise_mps = 0.01; // vy: the non-holonomic constraint, held loosely
+  HwName raw_channel{"rtfuse/wheel_odometry"};  // dead-reckoned odometry_t
+  double raw_rate_hz = 50.0;                    // 0: not published
+};
+
+struct AttitudeConfig {
+  AttitudeAlgorithmConfig algorithm = AttitudeAlgorithmConfig::kMadgwick;
+  double beta = 0.1;    // Madgwick gain
+  double zeta = 0.005;  // Madgwick gyro-bias gain
+  double kp = 1.0;      // Mahony proportional gain
+  double ki = 0.02;     // Mahony integral gain (gyro bias)
+};
+
+struct MpuConfig {
+  bool enabled = false;
+  HwName device{"/dev/i2c-1"};
+  std::uint8_t address = 0x68;
+  MpuModelConfig model = MpuModelConfig::kAuto;
+  int sample_rate_divider = 4;  // 1 kHz / (1 + 4) = 200 Hz with the DLPF on
+  int dlpf = 3;
+  int gyro_range_dps = 500;
+  int accel_range_g = 4;
+  HwName data_ready_chip;       // gpiochip label or path; "" = no line, poll
+  int data_ready_line = -1;
+  double poll_rate_hz = 200.0;  // without a data-ready line
+  HwName frame{"imu_link"};     // mounting: static transform base_link -> frame
+  int frozen_reads = 10;
+  double gyro_noise_rad_s = 0.005;   // per-sample 1-sigma
+  double accel_noise_mps2 = 0.05;
+  AttitudeConfig attitude;
+};
+
+struct HardwareConfig {
+  HalBackend backend = HalBackend::kNone;
+  std::string scenario;  // backend "sim": the drive scenario file (resolved path)
+  CanConfig can;
+  WheelOdometryConfig wheel_odometry;
+  MpuConfig mpu;
+  int wheel_sensor = -1;  // index of the [[sensor]] with source = "wheel_odometry"
+  int mpu_sensor = -1;    // index of the [[sensor]] with source = "mpu"
+};
+
+}  // namespace rtfuse
