@@ -6,6 +6,7 @@
 #include <vector>
 
 #include "geometry/rotation.hpp"
+#include "runtime/device_layout.hpp"
 #include "rtfuse/diagnostics_t.hpp"
 #include "rtfuse/filter_state_t.hpp"
 #include "rtfuse/odometry_t.hpp"
@@ -120,6 +121,7 @@ struct Publisher::Impl {
 
   PublishConfig cfg;  // owns the channel strings the outputs point into
   int num_sensors = 0;
+  int num_devices = 0;
   Output<rtfuse::odometry_t> odometry;
   Output<rtfuse::pose_with_covariance_stamped_t> pose;
   Output<rtfuse::tf_t> tf;
@@ -172,7 +174,25 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
     st.channel = c.sensors[static_cast<std::size_t>(i)].channel.c_str();
     st.level = rtfuse::sensor_status_t::STALE;
   }
+  DeviceStatus layout[kMaxDevices];
+  m.num_devices = describe_devices(c, layout, kMaxDevices);
+  m.diagnostics.msg.num_devices = m.num_devices;
+  m.diagnostics.msg.devices.resize(static_cast<std::size_t>(m.num_devices));
+  for (int i = 0; i < m.num_devices; ++i) {
+    auto& d = m.diagnostics.msg.devices[static_cast<std::size_t>(i)];
+    d.name = layout[i].name.c_str();
+    d.hardware_id = layout[i].hardware_id.c_str();
+    d.level = rtfuse::sensor_status_t::STALE;
+    d.num_values = layout[i].num_values;
+    d.keys.resize(static_cast<std::size_t>(layout[i].num_values));
+    d.values.assign(static_cast<std::size_t>(layout[i].num_values), 0);
+    for (int k = 0; k < layout[i].num_values; ++k) d.keys[static_cast<std::size_t>(k)] = layout[i].keys[k];
+    // Sized for the longest state word so the buffer and the string's
+    // capacity never have to grow in poll().
+    d.state.assign(decltype(layout[i].state)::max_size(), ' ');
+  }
   m.diagnostics.finalize();
+  for (auto& d : m.diagnostics.msg.devices) d.state = "starting";
 }
 
 Publisher::~Publisher() = default;
@@ -274,6 +294,14 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
         out.level = rtfuse::sensor_status_t::OK;
       }
       previous = rejected;
+    }
+    for (int i = 0; i < m.num_devices && i < s.num_devices; ++i) {
+      const DeviceStatus& in = s.devices[i];
+      auto& out = d.devices[static_cast<std::size_t>(i)];
+      out.level = static_cast<std::int8_t>(in.level);
+      out.state.assign(in.state.c_str());
+      const int n = in.num_values < out.num_values ? in.num_values : out.num_values;
+      for (int k = 0; k < n; ++k) out.values[static_cast<std::size_t>(k)] = in.values[k];
     }
     sent += m.emit(m.diagnostics, now, sink);
   }

@@ -4,6 +4,7 @@
 #include <cstdint>
 
 #include "runtime/config.hpp"
+#include "runtime/device_status.hpp"
 
 namespace rtfuse {
 
@@ -48,6 +49,8 @@ struct Snapshot {
   std::int64_t set_pose_rejected = 0;  // frame not connected to the world frame
   int num_sensors = 0;
   SensorStats sensors[kMaxSensors];
+  int num_devices = 0;
+  DeviceStatus devices[kMaxDevices];
 };
 
 }  // namespace rtfuse

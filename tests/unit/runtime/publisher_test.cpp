@@ -1,4 +1,5 @@
 #include "runtime/publisher.hpp"
+#include "runtime/device_layout.hpp"
 
 #include <gtest/gtest.h>
 
@@ -319,6 +320,76 @@ TEST(Publisher, SteadyStatePollNeverAllocates) {
   CaptureSink capture;
   pub.poll(s, 100'000 * kMs, capture);
   EXPECT_GT(probe.count(), 0u);
+  EXPECT_EQ(pub.encode_failures(), 0);
+}
+
+// A robot with two encoder nodes and an IMU: the diagnostics carry one
+// device_status_t per device with fixed keys, and only values, level and
+// state change from message to message, without allocating.
+TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
+  RuntimeConfig cfg = two_sensor_config();
+  cfg.publish.diagnostics_rate_hz = 100.0;
+  HardwareConfig& hw = cfg.hardware;
+  hw.backend = HalBackend::kLinux;
+  hw.can.enabled = true;
+  hw.can.num_nodes = 2;
+  hw.can.nodes[0].node_id = 1;
+  hw.can.nodes[1].node_id = 2;
+  hw.can.nodes[1].side = WheelSideConfig::kRight;
+  hw.wheel_sensor = 0;
+  hw.mpu.enabled = true;
+  hw.mpu_sensor = 1;
+  Publisher pub(cfg);
+
+  Snapshot s = known_snapshot();
+  s.num_devices = describe_devices(cfg, s.devices, kMaxDevices);
+  ASSERT_EQ(s.num_devices, 5);  // bus, 2 nodes, wheel odometry, imu
+  const DeviceSlots slots = device_slots(cfg);
+  DeviceStatus& right = s.devices[slots.first_node + 1];
+  right.level = DeviceLevel::kError;
+  right.state = "silent";
+  right.values[0] = 123456;  // counts
+  right.values[5] = 2;       // silent_events
+  s.devices[slots.imu].level = DeviceLevel::kOk;
+  s.devices[slots.imu].state = "sampling";
+
+  CaptureSink sink;
+  pub.poll(s, 1000 * kMs, sink);
+  auto d = sink.last<rtfuse::diagnostics_t>("rtfuse/diagnostics");
+  ASSERT_EQ(d.num_devices, 5);
+  EXPECT_EQ(d.devices[0].name, "can bus");
+  EXPECT_EQ(d.devices[0].hardware_id, "can0");
+  EXPECT_EQ(d.devices[2].name, "wheel right node 2");
+  EXPECT_EQ(d.devices[2].hardware_id, "can0 node 0x02");
+  EXPECT_EQ(d.devices[2].level, kError);
+  EXPECT_EQ(d.devices[2].state, "silent");
+  ASSERT_EQ(d.devices[2].num_values, kEncoderNodeKeyCount);
+  EXPECT_EQ(d.devices[2].keys[0], "counts");
+  EXPECT_EQ(d.devices[2].values[0], 123456);
+  EXPECT_EQ(d.devices[2].keys[5], "silent_events");
+  EXPECT_EQ(d.devices[2].values[5], 2);
+  EXPECT_EQ(d.devices[4].name, "imu");
+  EXPECT_EQ(d.devices[4].hardware_id, "/dev/i2c-1 0x68");
+  EXPECT_EQ(d.devices[4].state, "sampling");
+  EXPECT_EQ(d.devices[4].level, kOk);
+
+  // The node recovers: a longer state word, new values, no allocation.
+  right.level = DeviceLevel::kOk;
+  right.state = "operational-recovered";
+  right.values[8] = 1;  // recoveries
+  CountingSink counting;
+  std::size_t allocations = 0;
+  {
+    test::AllocScope scope;
+    for (int i = 0; i < 10; ++i) pub.poll(s, (1010 + 10 * i) * kMs, counting);
+    allocations = scope.count();
+  }
+  EXPECT_EQ(allocations, 0u);
+  EXPECT_GE(counting.messages, 10);
+  pub.poll(s, 2000 * kMs, sink);
+  d = sink.last<rtfuse::diagnostics_t>("rtfuse/diagnostics");
+  EXPECT_EQ(d.devices[2].state, "operational-recovered");
+  EXPECT_EQ(d.devices[2].values[8], 1);
   EXPECT_EQ(pub.encode_failures(), 0);
 }
 

@@ -1,0 +1,84 @@
+#include "runtime/device_layout.hpp"
+
+#include <cstdio>
+
+namespace rtfuse {
+
+const char* const kCanBusKeys[] = {"frames_received", "syncs_sent",   "send_failures", "malformed_frames",
+                                   "unexpected_cob_ids", "error_frames", "bus_off_events"};
+const int kCanBusKeyCount = sizeof(kCanBusKeys) / sizeof(kCanBusKeys[0]);
+
+const char* const kEncoderNodeKeys[] = {"counts",        "tpdos",        "heartbeats",  "emcy",
+                                        "last_emcy_code", "silent_events", "stuck_events", "jump_events",
+                                        "recoveries",    "nmt_starts"};
+const int kEncoderNodeKeyCount = sizeof(kEncoderNodeKeys) / sizeof(kEncoderNodeKeys[0]);
+
+const char* const kWheelOdometryKeys[] = {"twists", "no_side", "reseeds"};
+const int kWheelOdometryKeyCount = sizeof(kWheelOdometryKeys) / sizeof(kWheelOdometryKeys[0]);
+
+const char* const kImuKeys[] = {"samples",   "reads",     "nacks",         "bus_errors",         "timeouts",
+                                "frozen",    "saturated", "impossible",    "missing_edges",      "out_of_order_edges",
+                                "reinits",   "filter_rejects", "temperature_mdegc"};
+const int kImuKeyCount = sizeof(kImuKeys) / sizeof(kImuKeys[0]);
+
+DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
+  DeviceSlots s;
+  const HardwareConfig& hw = cfg.hardware;
+  if (hw.can.enabled) {
+    s.can_bus = s.count++;
+    s.first_node = s.count;
+    s.count += hw.can.num_nodes;
+  }
+  if (hw.wheel_sensor >= 0) s.wheel_odometry = s.count++;
+  if (hw.mpu.enabled) s.imu = s.count++;
+  return s;
+}
+
+namespace {
+
+void keys(DeviceStatus& d, const char* const* k, int n) noexcept {
+  d.num_values = 0;
+  for (int i = 0; i < n; ++i) d.add(k[i], 0);
+}
+
+}  // namespace
+
+int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexcept {
+  const DeviceSlots slots = device_slots(cfg);
+  if (slots.count > max) return 0;
+  const HardwareConfig& hw = cfg.hardware;
+  char buf[160];
+  for (int i = 0; i < slots.count; ++i) out[i] = DeviceStatus{};
+  if (slots.can_bus >= 0) {
+    DeviceStatus& d = out[slots.can_bus];
+    d.name = "can bus";
+    d.hardware_id = hw.can.interface.c_str();
+    keys(d, kCanBusKeys, kCanBusKeyCount);
+    for (int n = 0; n < hw.can.num_nodes; ++n) {
+      const WheelNodeConfig& node = hw.can.nodes[static_cast<std::size_t>(n)];
+      DeviceStatus& e = out[slots.first_node + n];
+      std::snprintf(buf, sizeof buf, "wheel %s node %d", node.side == WheelSideConfig::kLeft ? "left" : "right",
+                    node.node_id);
+      e.name = buf;
+      std::snprintf(buf, sizeof buf, "%s node 0x%02X", hw.can.interface.c_str(), node.node_id);
+      e.hardware_id = buf;
+      keys(e, kEncoderNodeKeys, kEncoderNodeKeyCount);
+    }
+  }
+  if (slots.wheel_odometry >= 0) {
+    DeviceStatus& d = out[slots.wheel_odometry];
+    d.name = "wheel odometry";
+    d.hardware_id = hw.can.interface.c_str();
+    keys(d, kWheelOdometryKeys, kWheelOdometryKeyCount);
+  }
+  if (slots.imu >= 0) {
+    DeviceStatus& d = out[slots.imu];
+    d.name = "imu";
+    std::snprintf(buf, sizeof buf, "%s 0x%02X", hw.mpu.device.c_str(), hw.mpu.address);
+    d.hardware_id = buf;
+    keys(d, kImuKeys, kImuKeyCount);
+  }
+  return slots.count;
+}
+
+}  // namespace rtfuse

@@ -1,0 +1,35 @@
+#pragma once
+// Which devices a configuration drives and the counters each one reports, in
+// a fixed order: the publisher sizes its diagnostics message from this once,
+// and the loop fills the same slots every tick (runtime/hardware.cpp).
+#include "runtime/config.hpp"
+#include "runtime/device_status.hpp"
+
+namespace rtfuse {
+
+// Slot order: CAN bus, then one per encoder node in [[can.node]] order, then
+// wheel odometry, then the IMU.
+struct DeviceSlots {
+  int can_bus = -1;
+  int first_node = -1;
+  int wheel_odometry = -1;
+  int imu = -1;
+  int count = 0;
+};
+
+DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept;
+
+// Names, hardware ids and the counter keys (values 0, level stale).
+int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexcept;
+
+// Counter keys per device kind, in the order the values are filled.
+extern const char* const kCanBusKeys[];
+extern const int kCanBusKeyCount;
+extern const char* const kEncoderNodeKeys[];
+extern const int kEncoderNodeKeyCount;
+extern const char* const kWheelOdometryKeys[];
+extern const int kWheelOdometryKeyCount;
+extern const char* const kImuKeys[];
+extern const int kImuKeyCount;
+
+}  // namespace rtfuse
