@@ -121,12 +121,16 @@ void FusionCore::tick(TimeNs now, const LoopStats& loop) noexcept {
   SetPoseCommand cmd;
   while (input_->set_pose_ring().try_pop(cmd)) apply_set_pose(cmd);
 
+  if (devices_ != nullptr) devices_->before_drain(now);
+
   // Bounded drain: at most the ring's capacity per sensor per tick.
   int n = 0;
   for (int i = 0; i < cfg_.num_sensors; ++i) {
     SpscRing<est::SensorSample>& ring = input_->ring(i);
     const int limit = 2 * cfg_.sensors[i].params.queue_size;
+    const int before = n;
     for (int k = 0; k < limit && n < staging_capacity_ && ring.try_pop(staging_[n]); ++k) ++n;
+    consumed_[i] += n - before;
   }
   // Stable insertion sort by stamp: n is small and often already ordered.
   for (int i = 1; i < n; ++i) {
@@ -175,6 +179,9 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
     st.rejected_overflow = c.overflow.load(std::memory_order_relaxed);
     s.sensors[i] = st;
   }
+  s.num_devices = 0;
+  s.wheel_odometry.valid = false;
+  if (devices_ != nullptr) devices_->fill_snapshot(s);
   snapshot_.store(s);
 }
 

@@ -14,6 +14,17 @@
 
 namespace rtfuse {
 
+// Work the loop does for the devices it drives itself, inside the tick: poll
+// the CAN encoders (their samples go into the sensors' rings before the
+// drain) and report device health and raw wheel odometry into the snapshot. runtime/hardware.cpp.
+class TickDevices {
+ public:
+  virtual ~TickDevices() = default;
+  virtual void before_drain(TimeNs now) noexcept = 0;
+  // Device statuses and the raw wheel odometry.
+  virtual void fill_snapshot(Snapshot& s) noexcept = 0;
+};
+
 class FusionCore {
  public:
   // Builds the frame tree from the static transforms; *error on a bad tree.
@@ -27,6 +38,13 @@ class FusionCore {
   void tick(TimeNs now, const LoopStats& loop) noexcept;
   const SeqLock<Snapshot>& snapshot() const { return snapshot_; }
   const est::Filter& filter() const { return *filter_; }
+
+  // Not owned; set before the loop starts.
+  void set_devices(TickDevices* devices) { devices_ = devices; }
+  // Samples the loop has taken from each sensor's ring since start, up to
+  // and including the last tick: what a recording needs to replay the same
+  // samples into the same ticks.
+  const std::int64_t* consumed() const { return consumed_; }
 
  private:
   explicit FusionCore(const RuntimeConfig& cfg);
@@ -50,6 +68,8 @@ class FusionCore {
   std::int64_t fused_total_ = 0;
   std::int64_t lagged_replays_ = 0;
   std::uint64_t seq_ = 0;
+  TickDevices* devices_ = nullptr;
+  std::int64_t consumed_[kMaxSensors] = {};
   Snapshot scratch_;
   SeqLock<Snapshot> snapshot_;
 };

@@ -127,6 +127,9 @@ struct Publisher::Impl {
   Output<rtfuse::tf_t> tf;
   Output<rtfuse::filter_state_t> state;
   Output<rtfuse::diagnostics_t> diagnostics;
+  Output<rtfuse::odometry_t> wheel_odometry;  // raw dead reckoning from the encoders
+  std::int64_t last_wheel_stamp = -1;
+  HwName wheel_channel;
   std::array<std::int64_t, kMaxSensors> rejections_at_last_diagnostics{};
   std::int64_t encode_failures = 0;
 };
@@ -193,6 +196,17 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
   }
   m.diagnostics.finalize();
   for (auto& d : m.diagnostics.msg.devices) d.state = "starting";
+
+  const WheelOdometryConfig& w = c.hardware.wheel_odometry;
+  m.wheel_channel = w.raw_channel;
+  m.wheel_odometry.channel = m.wheel_channel.c_str();
+  m.wheel_odometry.schedule.set_rate(c.hardware.wheel_sensor >= 0 ? w.raw_rate_hz : 0.0);
+  m.wheel_odometry.msg.header.frame_id = c.odom_frame.c_str();
+  m.wheel_odometry.msg.child_frame_id = base;
+  // Dead reckoning has no pose covariance worth the name: say "unknown" the
+  // way robot_localization users read it, a huge variance.
+  for (int i = 0; i < 6; ++i) m.wheel_odometry.msg.pose.covariance[i * 7] = 1e6;
+  m.wheel_odometry.finalize();
 }
 
 Publisher::~Publisher() = default;
@@ -246,6 +260,23 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
     for (int i = 0; i < kN; ++i) o.state[i] = s.state[i];
     for (int i = 0; i < kN * kN; ++i) o.covariance[i] = s.covariance[i];
     sent += m.emit(m.state, now, sink);
+  }
+
+  const WheelOdometrySnapshot& w = s.wheel_odometry;
+  if (w.valid && w.stamp_ns != m.last_wheel_stamp && m.wheel_odometry.schedule.due(now)) {
+    m.last_wheel_stamp = w.stamp_ns;
+    auto& o = m.wheel_odometry.msg;
+    o.header.utime = ns_to_utime(w.stamp_ns);
+    o.header.seq = m.wheel_odometry.next_seq();
+    o.pose.pose.position.x = w.x;
+    o.pose.pose.position.y = w.y;
+    o.pose.pose.orientation.z = std::sin(0.5 * w.yaw);
+    o.pose.pose.orientation.w = std::cos(0.5 * w.yaw);
+    o.twist.twist.linear.x = w.vx;
+    o.twist.twist.angular.z = w.vyaw;
+    o.twist.covariance[0] = w.var_vx;
+    o.twist.covariance[35] = w.var_vyaw;
+    sent += m.emit(m.wheel_odometry, now, sink);
   }
 
   if (m.diagnostics.schedule.due(now)) {

@@ -36,6 +36,16 @@ struct LoopStats {
   std::int64_t lagged_replays = 0;
 };
 
+// Dead reckoning from the wheels alone (exact arc integration of the
+// encoders' twist), published as "raw wheel odometry" to compare against.
+struct WheelOdometrySnapshot {
+  bool valid = false;
+  std::int64_t stamp_ns = 0;
+  double x = 0, y = 0, yaw = 0;
+  double vx = 0, vyaw = 0;
+  double var_vx = 0, var_vyaw = 0;
+};
+
 struct Snapshot {
   std::int64_t tick_time_ns = 0;   // loop clock when the snapshot was taken
   std::int64_t stamp_ns = 0;       // time the estimate is valid at (last measurement)
@@ -51,6 +61,7 @@ struct Snapshot {
   SensorStats sensors[kMaxSensors];
   int num_devices = 0;
   DeviceStatus devices[kMaxDevices];
+  WheelOdometrySnapshot wheel_odometry;
 };
 
 }  // namespace rtfuse

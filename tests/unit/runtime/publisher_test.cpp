@@ -393,5 +393,31 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   EXPECT_EQ(pub.encode_failures(), 0);
 }
 
+TEST(Publisher, RawWheelOdometryOncePerNewSample) {
+  RuntimeConfig cfg = two_sensor_config();
+  cfg.hardware.can.enabled = true;
+  cfg.hardware.wheel_sensor = 0;
+  cfg.hardware.wheel_odometry.raw_rate_hz = 1000.0;
+  Publisher pub(cfg);
+  CaptureSink sink;
+  Snapshot s = known_snapshot();
+  pub.poll(s, 0, sink);
+  EXPECT_EQ(sink.count("rtfuse/wheel_odometry"), 0u);  // nothing valid yet
+  s.wheel_odometry = WheelOdometrySnapshot{true, 5'000'000'000, 1.5, -2.0, 0.5, 0.8, 0.1, 1e-4, 4e-4};
+  pub.poll(s, 10 * kMs, sink);
+  pub.poll(s, 20 * kMs, sink);  // same sample: not repeated
+  ASSERT_EQ(sink.count("rtfuse/wheel_odometry"), 1u);
+  const auto o = sink.last<rtfuse::odometry_t>("rtfuse/wheel_odometry");
+  EXPECT_EQ(o.header.utime, 5'000'000);
+  EXPECT_EQ(o.header.frame_id, "odom");
+  EXPECT_EQ(o.child_frame_id, "base_link");
+  EXPECT_DOUBLE_EQ(o.pose.pose.position.x, 1.5);
+  EXPECT_DOUBLE_EQ(o.pose.pose.position.y, -2.0);
+  EXPECT_NEAR(2 * std::atan2(o.pose.pose.orientation.z, o.pose.pose.orientation.w), 0.5, 1e-12);
+  EXPECT_DOUBLE_EQ(o.twist.twist.linear.x, 0.8);
+  EXPECT_DOUBLE_EQ(o.twist.twist.angular.z, 0.1);
+  EXPECT_DOUBLE_EQ(o.twist.covariance[35], 4e-4);
+}
+
 }  // namespace
 }  // namespace rtfuse

@@ -1,0 +1,61 @@
+#include "runtime/linux_hal.hpp"
+
+#include "hal/linux/gpiod_line.hpp"
+#include "hal/linux/i2c_dev_bus.hpp"
+#include "hal/linux/monotonic_clock.hpp"
+#include "hal/linux/socketcan_bus.hpp"
+
+namespace rtfuse {
+
+struct LinuxHal::Devices {
+  std::unique_ptr<hal::SocketCanBus> can;
+  std::unique_ptr<hal::I2cDevBus> i2c;
+  std::unique_ptr<hal::GpiodEdgeSource> drdy;
+  hal::MonotonicClock clock;
+};
+
+LinuxHal::LinuxHal() : devices_(std::make_unique<Devices>()) {}
+LinuxHal::~LinuxHal() = default;
+
+int encoder_can_ids(const CanConfig& can, std::uint32_t* ids, int max) {
+  int n = 0;
+  for (int i = 0; i < can.num_nodes; ++i) {
+    const WheelNodeConfig& node = can.nodes[static_cast<std::size_t>(i)];
+    const std::uint32_t tpdo = node.tpdo_cob_id != 0 ? node.tpdo_cob_id : 0x180u + node.node_id;
+    for (std::uint32_t id : {tpdo, 0x700u + node.node_id, 0x080u + node.node_id}) {
+      if (n < max) ids[n++] = id;
+    }
+  }
+  return n;
+}
+
+std::unique_ptr<LinuxHal> LinuxHal::open(const RuntimeConfig& cfg, std::string* error) {
+  std::unique_ptr<LinuxHal> h(new LinuxHal());
+  const HardwareConfig& hw = cfg.hardware;
+  Devices& d = *h->devices_;
+  if (hw.can.enabled) {
+    std::uint32_t ids[3 * kMaxWheelNodes];
+    const int n = encoder_can_ids(hw.can, ids, 3 * kMaxWheelNodes);
+    hal::CanIdFilter filters[3 * kMaxWheelNodes];
+    for (int i = 0; i < n; ++i) filters[i] = hal::CanIdFilter{ids[i], 0x7FF, false};
+    d.can = hal::SocketCanBus::open(hw.can.interface.c_str(), filters, n, error);
+    if (!d.can) return nullptr;
+    h->buses_.can = d.can.get();
+  }
+  if (hw.mpu.enabled) {
+    d.i2c = hal::I2cDevBus::open(hw.mpu.device.c_str(), hal::I2cRetryPolicy{}, error);
+    if (!d.i2c) return nullptr;
+    h->buses_.i2c = d.i2c.get();
+    if (!hw.mpu.data_ready_chip.empty()) {
+      d.drdy = hal::GpiodEdgeSource::open(hw.mpu.data_ready_chip.c_str(),
+                                          static_cast<unsigned>(hw.mpu.data_ready_line), hal::EdgeKind::kRising,
+                                          error);
+      if (!d.drdy) return nullptr;
+      h->buses_.drdy = d.drdy.get();
+    }
+    h->buses_.imu_clock = &d.clock;
+  }
+  return h;
+}
+
+}  // namespace rtfuse

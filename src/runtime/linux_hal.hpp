@@ -1,0 +1,31 @@
+#pragma once
+// The real buses of a configuration: a SocketCAN socket filtered to the
+// encoder nodes' COB-IDs, /dev/i2c-N for the IMU, its data-ready line through
+// libgpiod, CLOCK_MONOTONIC. Opened once before start(); a missing kernel
+// feature or device fails here with the device, errno text and likely fix.
+#include <memory>
+#include <string>
+
+#include "runtime/config.hpp"
+#include "runtime/hal_buses.hpp"
+
+namespace rtfuse {
+
+class LinuxHal {
+ public:
+  static std::unique_ptr<LinuxHal> open(const RuntimeConfig& cfg, std::string* error);
+  ~LinuxHal();
+  HalBuses buses() const { return buses_; }
+
+ private:
+  LinuxHal();
+  struct Devices;
+  std::unique_ptr<Devices> devices_;
+  HalBuses buses_;
+};
+
+// The COB-IDs the encoder driver listens to (TPDO, heartbeat, EMCY of every
+// node): the kernel drops everything else before it reaches the loop.
+int encoder_can_ids(const CanConfig& can, std::uint32_t* ids, int max);
+
+}  // namespace rtfuse
