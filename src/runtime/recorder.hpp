@@ -1,0 +1,173 @@
+#pragma once
+// rtfused --record FILE.lcm: the non-real-time side of HAL recording.
+//
+// The recording decorators (hal/recording_*.hpp) of each producing thread
+// push BusEvents into that thread's ring (ring(stream)); the loop pushes one
+// record per tick (record_tick) and the publisher a copy of every published
+// message (record_output, or RecordingSink). None of these block or allocate:
+// a full ring drops the record and counts it. The writer thread "rtfuse-rec"
+// drains every ring, encodes (transport/hal_record_codec.hpp) and appends to
+// an lcm-logger file, sleeping a few milliseconds whenever all rings are
+// empty. The file starts with the recording_info_t, written by create(), so
+// even a recorder killed at once leaves a recognisable recording.
+//
+// File order is drain order: events of one stream stay in call order, ticks
+// in tick order, outputs in publish order; nothing orders one ring against
+// another (replay does not need it: each thread replays its own stream).
+#include <atomic>
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <thread>
+#include <vector>
+
+#include "core/fixed_string.hpp"
+#include "core/spsc_ring.hpp"
+#include "core/time.hpp"
+#include "hal/bus_event.hpp"
+#include "runtime/config.hpp"
+#include "runtime/publisher.hpp"
+#include "transport/event_log.hpp"
+#include "transport/hal_record_codec.hpp"
+
+namespace rtfuse::runtime {
+
+struct RecorderRingSizes {
+  std::size_t bus_events = 4096;  // per stream; a 1 kHz IMU thread makes ~3 events per sample
+  std::size_t ticks = 1024;
+  std::size_t outputs = 256;
+};
+
+struct RecorderStats {
+  std::int64_t events_written = 0;  // log events, the recording_info_t included
+  std::int64_t bytes_written = 0;   // as laid out in the file (headers, channels, data)
+  std::int64_t write_errors = 0;    // records the file did not take (disk full...)
+  std::int64_t encode_errors = 0;   // bus events for a device or call the info does not list
+  // Per stream: bus events lost to a full ring, as the event after each loss
+  // reports it (a loss at the very end of a run is only in the decorators'
+  // own overflows() counters).
+  std::vector<std::int64_t> bus_events_lost;
+  std::int64_t ticks_lost = 0;        // tick ring full
+  std::int64_t ticks_rejected = 0;    // more sensors than a tick record holds
+  std::int64_t outputs_lost = 0;      // output ring full
+  std::int64_t outputs_rejected = 0;  // larger than kMaxOutputBytes or a bad channel name
+};
+
+namespace recorder_detail {
+constexpr int kMaxOutputBytes = 8192;
+constexpr std::size_t kMaxChannelLength = 63;
+constexpr int kMaxTickSensors = kMaxSensors;
+
+// Ring slots (outside Recorder: a nested type is incomplete, for SpscRing's
+// checks, until the class ends).
+struct TickSlot {
+  TimeNs time_ns = 0;
+  std::int64_t seq = 0;
+  std::int32_t n = 0;
+  std::int64_t consumed[kMaxTickSensors] = {};
+};
+struct OutputSlot {
+  TimeNs now = 0;
+  std::int32_t size = 0;
+  FixedString<kMaxChannelLength> channel;
+  std::uint8_t data[kMaxOutputBytes] = {};
+};
+}  // namespace recorder_detail
+
+class Recorder {
+ public:
+  static constexpr int kMaxOutputBytes = recorder_detail::kMaxOutputBytes;
+  static constexpr std::size_t kMaxChannelLength = recorder_detail::kMaxChannelLength;
+  static constexpr int kMaxTickSensors = recorder_detail::kMaxTickSensors;
+  // How long the writer sleeps when every ring is empty.
+  static constexpr TimeNs kIdleSleepNs = 2'000'000;
+
+  // Opens (truncates) `path` and writes the recording_info_t. info.start_ns
+  // 0 becomes now; config_hash is computed from config_text. Null with the
+  // error when the info is invalid or the file cannot be written.
+  static std::unique_ptr<Recorder> create(const std::string& path, transport::RecordingInfo info,
+                                          const RecorderRingSizes& sizes, std::string* error);
+  ~Recorder();  // stop()
+  Recorder(const Recorder&) = delete;
+  Recorder& operator=(const Recorder&) = delete;
+
+  const transport::RecordingInfo& info() const { return info_; }
+  int stream_count() const { return static_cast<int>(rings_.size()); }
+  // Index of a stream by name, -1 if none.
+  int stream_index(std::string_view name) const;
+  // The ring the decorators of `stream`'s thread push into (0 <= stream < stream_count()).
+  SpscRing<hal::BusEvent>& ring(int stream) { return *rings_[static_cast<std::size_t>(stream)]; }
+
+  // Loop thread only. consumed[i]: samples taken from sensor i's ring since
+  // start, up to and including this tick. False: not recorded (ring full, or
+  // n outside 0..kMaxTickSensors), counted.
+  bool record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n) noexcept;
+  // Publisher thread only. The bytes are copied. False: not recorded (ring
+  // full, too large, channel empty or longer than kMaxChannelLength), counted.
+  bool record_output(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept;
+
+  // Starts the writer thread. False with the reason if it cannot.
+  bool start(std::string* error);
+  // Call after the producers stopped: drains every ring, flushes, closes the
+  // file and joins. Idempotent. False with the first write error if any
+  // record or the final flush failed.
+  bool stop(std::string* error = nullptr);
+
+  // Counters so far; allocates (call from a non-RT thread).
+  RecorderStats stats() const;
+
+ private:
+  using TickSlot = recorder_detail::TickSlot;
+  using OutputSlot = recorder_detail::OutputSlot;
+
+  Recorder(transport::RecordingInfo info, const RecorderRingSizes& sizes);
+  void run() noexcept;
+  // One pass over every ring (a bounded batch each); records written.
+  std::size_t drain_once() noexcept;
+  void write(std::int64_t utime, std::string_view channel, const std::uint8_t* data, std::size_t size) noexcept;
+
+  transport::RecordingInfo info_;
+  transport::HalRecordCodec codec_;
+  transport::EventLogWriter writer_;
+  std::vector<std::unique_ptr<SpscRing<hal::BusEvent>>> rings_;
+  SpscRing<TickSlot> ticks_;
+  SpscRing<OutputSlot> outputs_;
+  // Producer-side staging: one per producing thread, so an 8 KiB slot is not
+  // built on that thread's stack.
+  TickSlot tick_staging_;
+  OutputSlot output_staging_;
+
+  std::thread thread_;
+  std::atomic<bool> stop_requested_{false};
+  bool stopped_ = false;
+  std::string first_error_;  // writer thread; read after join
+
+  std::atomic<std::int64_t> events_written_{0};
+  std::atomic<std::int64_t> bytes_written_{0};
+  std::atomic<std::int64_t> write_errors_{0};
+  std::atomic<std::int64_t> encode_errors_{0};
+  std::unique_ptr<std::atomic<std::int64_t>[]> bus_lost_;
+  std::atomic<std::int64_t> ticks_lost_{0};
+  std::atomic<std::int64_t> ticks_rejected_{0};
+  std::atomic<std::int64_t> outputs_lost_{0};
+  std::atomic<std::int64_t> outputs_rejected_{0};
+};
+
+// A MessageSink that publishes through `inner` and records every message it
+// was given into the recorder (the publisher thread's end of record_output).
+class RecordingSink final : public MessageSink {
+ public:
+  RecordingSink(MessageSink& inner, Recorder& recorder) : inner_(inner), recorder_(recorder) {}
+  bool publish(const char* channel, const std::uint8_t* data, int size, TimeNs now) override {
+    recorder_.record_output(channel, data, size, now);
+    return inner_.publish(channel, data, size, now);
+  }
+
+ private:
+  MessageSink& inner_;
+  Recorder& recorder_;
+};
+
+}  // namespace rtfuse::runtime

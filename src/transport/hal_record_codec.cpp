@@ -1,0 +1,641 @@
+#include "transport/hal_record_codec.hpp"
+
+#include <algorithm>
+#include <exception>
+#include <limits>
+#include <utility>
+
+#include "rtfuse/hal_can_t.hpp"
+#include "rtfuse/hal_clock_t.hpp"
+#include "rtfuse/hal_gpio_t.hpp"
+#include "rtfuse/hal_i2c_t.hpp"
+#include "rtfuse/loop_tick_t.hpp"
+#include "rtfuse/recording_info_t.hpp"
+#include "transport/encode_buffer.hpp"
+
+namespace rtfuse::transport {
+
+using hal::BusEvent;
+using hal::BusEventKind;
+using hal::CanBusState;
+using hal::HalStatus;
+
+namespace {
+
+constexpr int kMaxStatus = static_cast<int>(HalStatus::kMalformed);
+constexpr int kMaxBusState = static_cast<int>(CanBusState::kBusOff);
+
+std::int32_t load_i32(const std::uint8_t* p) {
+  const std::uint32_t v = (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) |
+                          (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]};
+  return static_cast<std::int32_t>(v);
+}
+
+std::int64_t load_i64(const std::uint8_t* p) {
+  std::uint64_t v = 0;
+  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
+  return static_cast<std::int64_t>(v);
+}
+
+void set_error(std::string* error, std::string message) {
+  if (error != nullptr) *error = std::move(message);
+}
+
+// lcm-gen's decode() sizes a vector from the count field before it checks
+// that the bytes are there, and turns a string length <= 0 into a throwing
+// assign: counts and the leading string are bounded here first, so a corrupt
+// record cannot make the loader reserve gigabytes.
+//
+// Every hal_* record starts with fingerprint, utime, time_ns, then the device
+// string. Offset just past that string, or -1.
+int after_device_string(const std::uint8_t* b, int size) {
+  constexpr int kAt = 8 + 8 + 8;
+  if (size < kAt + 4) return -1;
+  const std::int32_t len = load_i32(b + kAt);
+  if (len < 1 || len > size - kAt - 4) return -1;
+  return kAt + 4 + len;
+}
+
+bool count_within(const std::uint8_t* b, int size, int at, int max) {
+  if (at < 0 || size - at < 4) return false;
+  const std::int32_t v = load_i32(b + at);
+  return v >= 0 && v <= max;
+}
+
+template <class Msg>
+bool decode_message(Msg& msg, const void* data, int size, const char* type, std::string* error) {
+  if (data == nullptr || size < 8) {
+    set_error(error, std::string(type) + " record of " + std::to_string(size) + " bytes is too short");
+    return false;
+  }
+  if (load_i64(static_cast<const std::uint8_t*>(data)) != Msg::getHash()) {
+    set_error(error, std::string("not a ") + type + " (the type fingerprint differs)");
+    return false;
+  }
+  int used = -1;
+  try {
+    used = msg.decode(data, 0, size);
+  } catch (const std::exception&) {
+    used = -1;
+  }
+  if (used < 0) {
+    set_error(error, std::string("malformed ") + type + ": the bytes end early or a length is invalid");
+    return false;
+  }
+  if (used != size) {
+    set_error(error, std::string(type) + " has " + std::to_string(size - used) + " trailing bytes");
+    return false;
+  }
+  return true;
+}
+
+bool valid_status(int s) { return s >= 0 && s <= kMaxStatus; }
+
+bool bad_field(std::string* error, const char* type, const char* field, long long value) {
+  set_error(error, std::string(type) + ": impossible " + field + " " + std::to_string(value));
+  return false;
+}
+
+}  // namespace
+
+const char* to_string(DeviceKind k) noexcept {
+  switch (k) {
+    case DeviceKind::kCan: return "can";
+    case DeviceKind::kI2c: return "i2c";
+    case DeviceKind::kGpioEdge: return "gpio-edge";
+    case DeviceKind::kGpioOutput: return "gpio-output";
+    case DeviceKind::kClock: return "clock";
+  }
+  return "unknown";
+}
+
+bool records(DeviceKind device, BusEventKind call) noexcept {
+  switch (device) {
+    case DeviceKind::kCan: return call == BusEventKind::kCanSend || call == BusEventKind::kCanReceive;
+    case DeviceKind::kI2c: return call == BusEventKind::kI2cRead || call == BusEventKind::kI2cWrite;
+    case DeviceKind::kGpioEdge: return call == BusEventKind::kGpioWaitEdge;
+    case DeviceKind::kGpioOutput: return call == BusEventKind::kGpioSet;
+    case DeviceKind::kClock: return call == BusEventKind::kClockNow || call == BusEventKind::kClockSleepUntil;
+  }
+  return false;
+}
+
+std::int64_t config_text_hash(std::string_view text) noexcept {
+  std::uint64_t h = 0xcbf29ce484222325ull;
+  for (const char c : text) {
+    h ^= static_cast<unsigned char>(c);
+    h *= 0x100000001b3ull;
+  }
+  return static_cast<std::int64_t>(h);
+}
+
+bool validate(const RecordingInfo& info, std::string* error) {
+  const auto n_streams = static_cast<int>(info.streams.size());
+  if (n_streams < 1 || n_streams > kMaxRecordedStreams) {
+    set_error(error, "recording info: " + std::to_string(n_streams) + " streams (expected 1.." +
+                         std::to_string(kMaxRecordedStreams) + ", one per thread that uses recorded devices)");
+    return false;
+  }
+  if (info.devices.size() > static_cast<std::size_t>(kMaxRecordedDevices)) {
+    set_error(error, "recording info: " + std::to_string(info.devices.size()) + " devices (at most " +
+                         std::to_string(kMaxRecordedDevices) + ")");
+    return false;
+  }
+  for (std::size_t i = 0; i < info.devices.size(); ++i) {
+    const RecordedDevice& d = info.devices[i];
+    const std::string where = "recording info: device " + std::to_string(i) + " '" + d.name + "'";
+    if (d.name.empty() || d.name.size() > kMaxDeviceNameLength ||
+        d.name.find_first_of("/ \t\n") != std::string::npos) {
+      set_error(error, where + ": a device name is 1.." + std::to_string(kMaxDeviceNameLength) +
+                           " characters without '/' or spaces (it becomes the channel rtfuse/hal/<name>)");
+      return false;
+    }
+    if (static_cast<int>(d.kind) > static_cast<int>(DeviceKind::kClock)) {
+      set_error(error, where + ": unknown device kind " + std::to_string(static_cast<int>(d.kind)));
+      return false;
+    }
+    if (d.stream < 0 || d.stream >= n_streams) {
+      set_error(error, where + ": stream " + std::to_string(d.stream) + " does not exist (0.." +
+                           std::to_string(n_streams - 1) + ")");
+      return false;
+    }
+    for (std::size_t j = 0; j < i; ++j) {
+      if (info.devices[j].name == d.name) {
+        set_error(error, where + ": the name is also device " + std::to_string(j) + "'s");
+        return false;
+      }
+    }
+  }
+  return true;
+}
+
+std::vector<std::uint8_t> encode_recording_info(const RecordingInfo& info) {
+  rtfuse::recording_info_t m;
+  m.utime = ns_to_utime(info.start_ns);
+  m.format_version = info.format_version;
+  m.config_hash = info.config_hash;
+  m.num_streams = static_cast<std::int32_t>(info.streams.size());
+  m.num_devices = static_cast<std::int32_t>(info.devices.size());
+  m.rtfuse_version = info.rtfuse_version;
+  m.config_path = info.config_path;
+  m.config_text = info.config_text;
+  m.streams = info.streams;
+  for (const RecordedDevice& d : info.devices) {
+    m.device_names.push_back(d.name);
+    m.device_kinds.push_back(static_cast<std::int8_t>(d.kind));
+    m.device_streams.push_back(static_cast<std::int8_t>(d.stream));
+  }
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::string* error) {
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  // The version sits at a fixed offset (after fingerprint and utime): read it
+  // first, so a recording in another format says so instead of "malformed".
+  constexpr int kVersionAt = 16;
+  if (b != nullptr && size >= kVersionAt + 4 && load_i32(b + kVersionAt) != kHalRecordFormatVersion) {
+    set_error(error, "recorded in HAL record format version " + std::to_string(load_i32(b + kVersionAt)) +
+                         ", this rtfuse reads version " + std::to_string(kHalRecordFormatVersion) +
+                         ": replay it with the rtfuse version that recorded it");
+    return false;
+  }
+  if (b == nullptr || !count_within(b, size, 28, kMaxRecordedStreams) ||
+      !count_within(b, size, 32, kMaxRecordedDevices)) {
+    set_error(error, "not a recording_info_t: too short, or stream/device counts out of range");
+    return false;
+  }
+  rtfuse::recording_info_t m;
+  if (!decode_message(m, data, size, "recording_info_t", error)) return false;
+  RecordingInfo info;
+  info.format_version = m.format_version;
+  info.start_ns = utime_to_ns(m.utime);
+  info.rtfuse_version = m.rtfuse_version;
+  info.config_path = m.config_path;
+  info.config_text = m.config_text;
+  info.config_hash = m.config_hash;
+  info.streams = m.streams;
+  for (int i = 0; i < m.num_devices; ++i) {
+    const auto idx = static_cast<std::size_t>(i);
+    if (m.device_kinds[idx] < 0 || m.device_kinds[idx] > static_cast<std::int8_t>(DeviceKind::kClock)) {
+      set_error(error, "recording_info_t: device " + std::to_string(i) + " has unknown kind " +
+                           std::to_string(m.device_kinds[idx]));
+      return false;
+    }
+    info.devices.push_back(RecordedDevice{m.device_names[idx], static_cast<DeviceKind>(m.device_kinds[idx]),
+                                          m.device_streams[idx]});
+  }
+  if (!validate(info, error)) return false;
+  *out = std::move(info);
+  return true;
+}
+
+// ---------------------------------------------------------------- codec
+
+struct HalRecordCodec::Messages {
+  rtfuse::hal_can_t can;
+  rtfuse::hal_i2c_t i2c;
+  rtfuse::hal_gpio_t gpio;
+  rtfuse::hal_clock_t clock;
+  rtfuse::loop_tick_t tick;
+};
+
+HalRecordCodec::HalRecordCodec(std::vector<RecordedDevice> devices)
+    : devices_(std::move(devices)), msgs_(std::make_unique<Messages>()) {
+  for (const RecordedDevice& d : devices_) channels_.push_back(std::string(kHalChannelPrefix) + d.name);
+  // Capacity up front, so encoding stops allocating once every name was used.
+  msgs_->can.frames.reserve(hal::kBusEventMaxFrames);
+  msgs_->i2c.data.reserve(hal::kBusEventMaxBytes);
+  msgs_->tick.consumed.reserve(kMaxTickSensors);
+  for (std::string* s : {&msgs_->can.device, &msgs_->i2c.device, &msgs_->gpio.device, &msgs_->clock.device}) {
+    s->reserve(kMaxDeviceNameLength);
+  }
+}
+
+HalRecordCodec::~HalRecordCodec() = default;
+
+std::string_view HalRecordCodec::channel(std::uint8_t device) const noexcept {
+  return device < channels_.size() ? std::string_view(channels_[device]) : std::string_view();
+}
+
+int HalRecordCodec::device_of(std::string_view channel) const noexcept {
+  for (std::size_t i = 0; i < channels_.size(); ++i) {
+    if (channels_[i] == channel) return static_cast<int>(i);
+  }
+  return -1;
+}
+
+int HalRecordCodec::encode(const BusEvent& ev, std::uint8_t* buf, int capacity) {
+  if (ev.device >= devices_.size()) return -1;
+  const RecordedDevice& dev = devices_[ev.device];
+  if (!records(dev.kind, ev.kind)) return -1;
+  const std::int64_t utime = ns_to_utime(ev.time_ns);
+  const auto status = static_cast<std::int8_t>(ev.status);
+  const auto lost = static_cast<std::int32_t>(ev.lost_before);
+  switch (dev.kind) {
+    case DeviceKind::kCan: {
+      rtfuse::hal_can_t& m = msgs_->can;
+      m.utime = utime;
+      m.time_ns = ev.time_ns;
+      m.device = dev.name;
+      m.call = ev.kind == BusEventKind::kCanSend ? rtfuse::hal_can_t::SEND : rtfuse::hal_can_t::RECEIVE;
+      m.status = status;
+      m.bus_state = static_cast<std::int8_t>(ev.bus_state);
+      m.max_frames = ev.length;
+      m.timeout_ns = ev.timeout_ns;
+      m.lost_before = lost;
+      const int n = std::min<int>(ev.count, hal::kBusEventMaxFrames);
+      m.num_frames = n;
+      m.frames.resize(static_cast<std::size_t>(n));
+      for (int i = 0; i < n; ++i) {
+        const hal::CanFrame& f = ev.frames[i];
+        rtfuse::can_frame_t& g = m.frames[static_cast<std::size_t>(i)];
+        g.stamp_ns = f.stamp;
+        g.id = static_cast<std::int32_t>(f.id);
+        g.extended = f.extended;
+        g.rtr = f.rtr;
+        g.error = f.error;
+        g.dlc = static_cast<std::int8_t>(f.dlc);
+        std::copy(f.data, f.data + 8, g.data);
+      }
+      return encode_into(m, buf, capacity);
+    }
+    case DeviceKind::kI2c: {
+      rtfuse::hal_i2c_t& m = msgs_->i2c;
+      m.utime = utime;
+      m.time_ns = ev.time_ns;
+      m.device = dev.name;
+      m.call = ev.kind == BusEventKind::kI2cRead ? rtfuse::hal_i2c_t::READ : rtfuse::hal_i2c_t::WRITE;
+      m.status = status;
+      m.address = ev.address;
+      m.reg = ev.reg;
+      m.length = ev.length;
+      m.value = ev.value;
+      m.retries = ev.retries;
+      m.lost_before = lost;
+      const bool has_data = ev.kind == BusEventKind::kI2cRead && ev.status == HalStatus::kOk && ev.length > 0 &&
+                            ev.length <= hal::kBusEventMaxBytes;
+      m.num_data = has_data ? ev.length : 0;
+      m.data.assign(ev.data, ev.data + m.num_data);
+      return encode_into(m, buf, capacity);
+    }
+    case DeviceKind::kGpioEdge:
+    case DeviceKind::kGpioOutput: {
+      rtfuse::hal_gpio_t& m = msgs_->gpio;
+      const bool wait = ev.kind == BusEventKind::kGpioWaitEdge;
+      m.utime = utime;
+      m.time_ns = ev.time_ns;
+      m.device = dev.name;
+      m.call = wait ? rtfuse::hal_gpio_t::WAIT_EDGE : rtfuse::hal_gpio_t::SET;
+      m.status = status;
+      m.timeout_ns = ev.timeout_ns;
+      m.edge_stamp_ns = ev.edge_stamp;
+      m.rising = wait && ev.level != 0;
+      m.level = !wait && ev.level != 0;
+      m.lost_before = lost;
+      return encode_into(m, buf, capacity);
+    }
+    case DeviceKind::kClock: {
+      rtfuse::hal_clock_t& m = msgs_->clock;
+      m.utime = utime;
+      m.time_ns = ev.time_ns;
+      m.device = dev.name;
+      m.call = ev.kind == BusEventKind::kClockNow ? rtfuse::hal_clock_t::NOW : rtfuse::hal_clock_t::SLEEP_UNTIL;
+      m.status = status;
+      m.value_ns = ev.clock_ns;
+      m.lost_before = lost;
+      return encode_into(m, buf, capacity);
+    }
+  }
+  return -1;
+}
+
+bool HalRecordCodec::decode(std::string_view channel, const void* data, int size, BusEvent* out,
+                            std::string* error) {
+  const int device = device_of(channel);
+  if (device < 0) {
+    set_error(error, "channel " + std::string(channel) + " names no device of the recording_info");
+    return false;
+  }
+  const RecordedDevice& dev = devices_[static_cast<std::size_t>(device)];
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  const int after_name = b == nullptr ? -1 : after_device_string(b, size);
+  BusEvent ev;
+  ev.device = static_cast<std::uint8_t>(device);
+  auto check_common = [&](const std::string& name, std::int8_t status, const char* type) {
+    if (name != dev.name) {
+      set_error(error, std::string(type) + " names device '" + name + "' on the channel of '" + dev.name + "'");
+      return false;
+    }
+    if (!valid_status(status)) return bad_field(error, type, "status", status);
+    ev.status = static_cast<HalStatus>(status);
+    return true;
+  };
+  switch (dev.kind) {
+    case DeviceKind::kCan: {
+      constexpr const char* kType = "hal_can_t";
+      // call, status, bus_state, max_frames, timeout_ns, lost_before: 19 bytes to num_frames.
+      if (!count_within(b, size, after_name < 0 ? -1 : after_name + 19, hal::kBusEventMaxFrames)) {
+        set_error(error, "malformed hal_can_t: too short, or more than 16 frames");
+        return false;
+      }
+      rtfuse::hal_can_t& m = msgs_->can;
+      if (!decode_message(m, data, size, kType, error) || !check_common(m.device, m.status, kType)) return false;
+      if (m.call != rtfuse::hal_can_t::SEND && m.call != rtfuse::hal_can_t::RECEIVE) {
+        return bad_field(error, kType, "call", m.call);
+      }
+      if (m.bus_state < 0 || m.bus_state > kMaxBusState) return bad_field(error, kType, "bus_state", m.bus_state);
+      const bool send = m.call == rtfuse::hal_can_t::SEND;
+      if (send && m.num_frames != 1) return bad_field(error, kType, "frame count for a send", m.num_frames);
+      if (!send && m.num_frames > std::max(m.max_frames, 0)) {
+        return bad_field(error, kType, "frame count above max_frames", m.num_frames);
+      }
+      ev.kind = send ? BusEventKind::kCanSend : BusEventKind::kCanReceive;
+      ev.bus_state = static_cast<CanBusState>(m.bus_state);
+      ev.length = m.max_frames;
+      ev.timeout_ns = m.timeout_ns;
+      ev.count = static_cast<std::uint8_t>(m.num_frames);
+      for (int i = 0; i < m.num_frames; ++i) {
+        const rtfuse::can_frame_t& g = m.frames[static_cast<std::size_t>(i)];
+        hal::CanFrame& f = ev.frames[i];
+        f.stamp = g.stamp_ns;
+        f.id = static_cast<std::uint32_t>(g.id);
+        f.extended = g.extended != 0;
+        f.rtr = g.rtr != 0;
+        f.error = g.error != 0;
+        f.dlc = static_cast<std::uint8_t>(g.dlc);
+        std::copy(g.data, g.data + 8, f.data);
+      }
+      ev.time_ns = m.time_ns;
+      ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
+      break;
+    }
+    case DeviceKind::kI2c: {
+      constexpr const char* kType = "hal_i2c_t";
+      // call, status, address, reg, length, value, retries, lost_before: 23 bytes to num_data.
+      if (!count_within(b, size, after_name < 0 ? -1 : after_name + 23, hal::kBusEventMaxBytes)) {
+        set_error(error, "malformed hal_i2c_t: too short, or more than 64 data bytes");
+        return false;
+      }
+      rtfuse::hal_i2c_t& m = msgs_->i2c;
+      if (!decode_message(m, data, size, kType, error) || !check_common(m.device, m.status, kType)) return false;
+      if (m.call != rtfuse::hal_i2c_t::READ && m.call != rtfuse::hal_i2c_t::WRITE) {
+        return bad_field(error, kType, "call", m.call);
+      }
+      if (m.address < 0 || m.address > 0xFF) return bad_field(error, kType, "address", m.address);
+      if (m.reg < 0 || m.reg > 0xFF) return bad_field(error, kType, "register", m.reg);
+      const bool read = m.call == rtfuse::hal_i2c_t::READ;
+      if (m.num_data > 0 && (!read || m.num_data != m.length)) {
+        return bad_field(error, kType, "data byte count", m.num_data);
+      }
+      ev.kind = read ? BusEventKind::kI2cRead : BusEventKind::kI2cWrite;
+      ev.address = static_cast<std::uint8_t>(m.address);
+      ev.reg = static_cast<std::uint8_t>(m.reg);
+      ev.length = m.length;
+      ev.value = m.value;
+      ev.retries = m.retries;
+      std::copy(m.data.begin(), m.data.begin() + m.num_data, ev.data);
+      ev.time_ns = m.time_ns;
+      ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
+      break;
+    }
+    case DeviceKind::kGpioEdge:
+    case DeviceKind::kGpioOutput: {
+      constexpr const char* kType = "hal_gpio_t";
+      if (after_name < 0) {
+        set_error(error, "malformed hal_gpio_t: too short or a bad device name length");
+        return false;
+      }
+      rtfuse::hal_gpio_t& m = msgs_->gpio;
+      if (!decode_message(m, data, size, kType, error) || !check_common(m.device, m.status, kType)) return false;
+      const std::int8_t expected =
+          dev.kind == DeviceKind::kGpioEdge ? rtfuse::hal_gpio_t::WAIT_EDGE : rtfuse::hal_gpio_t::SET;
+      if (m.call != expected) return bad_field(error, kType, "call for this line", m.call);
+      const bool wait = m.call == rtfuse::hal_gpio_t::WAIT_EDGE;
+      ev.kind = wait ? BusEventKind::kGpioWaitEdge : BusEventKind::kGpioSet;
+      ev.timeout_ns = m.timeout_ns;
+      ev.edge_stamp = m.edge_stamp_ns;
+      ev.level = (wait ? m.rising : m.level) != 0 ? 1 : 0;
+      ev.time_ns = m.time_ns;
+      ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
+      break;
+    }
+    case DeviceKind::kClock: {
+      constexpr const char* kType = "hal_clock_t";
+      if (after_name < 0) {
+        set_error(error, "malformed hal_clock_t: too short or a bad device name length");
+        return false;
+      }
+      rtfuse::hal_clock_t& m = msgs_->clock;
+      if (!decode_message(m, data, size, kType, error) || !check_common(m.device, m.status, kType)) return false;
+      if (m.call != rtfuse::hal_clock_t::NOW && m.call != rtfuse::hal_clock_t::SLEEP_UNTIL) {
+        return bad_field(error, kType, "call", m.call);
+      }
+      ev.kind = m.call == rtfuse::hal_clock_t::NOW ? BusEventKind::kClockNow : BusEventKind::kClockSleepUntil;
+      ev.clock_ns = m.value_ns;
+      ev.time_ns = m.time_ns;
+      ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
+      break;
+    }
+  }
+  *out = ev;
+  return true;
+}
+
+int HalRecordCodec::encode_tick(TimeNs time_ns, std::int64_t seq, const std::int64_t* consumed, int n,
+                                std::uint8_t* buf, int capacity) {
+  if (n < 0 || n > kMaxTickSensors || (n > 0 && consumed == nullptr)) return -1;
+  rtfuse::loop_tick_t& m = msgs_->tick;
+  m.utime = ns_to_utime(time_ns);
+  m.time_ns = time_ns;
+  m.seq = seq;
+  m.num_sensors = n;
+  m.consumed.assign(consumed, consumed + n);
+  return encode_into(m, buf, capacity);
+}
+
+bool HalRecordCodec::decode_tick(const void* data, int size, LoopTick* out, std::string* error) {
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  if (b == nullptr || !count_within(b, size, 32, kMaxTickSensors)) {
+    set_error(error, "malformed loop_tick_t: too short, or more than " + std::to_string(kMaxTickSensors) +
+                         " sensors");
+    return false;
+  }
+  rtfuse::loop_tick_t m;
+  if (!decode_message(m, data, size, "loop_tick_t", error)) return false;
+  out->time_ns = m.time_ns;
+  out->seq = m.seq;
+  out->consumed = std::move(m.consumed);
+  return true;
+}
+
+// ---------------------------------------------------------------- loader
+
+namespace {
+
+bool starts_with(std::string_view s, std::string_view prefix) {
+  return s.size() >= prefix.size() && s.substr(0, prefix.size()) == prefix;
+}
+
+}  // namespace
+
+bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& options, HalRecording* out,
+                        std::string* error) {
+  HalRecording rec;
+  const std::string& path = reader.path();
+  LogEvent ev;
+  std::string read_error;
+
+  ReadStatus st = reader.next(&ev, &read_error);
+  if (st == ReadStatus::kEnd) {
+    set_error(error, "file " + path + " is empty: not an rtfuse HAL recording (rtfused --record writes one)");
+    return false;
+  }
+  if (st == ReadStatus::kError) {
+    set_error(error, read_error);
+    return false;
+  }
+  if (ev.channel != kRecordingInfoChannel) {
+    set_error(error, "file " + path + " is not an rtfuse HAL recording: event " + std::to_string(ev.event_number) +
+                         " is on channel '" + std::string(ev.channel) + "', a recording starts with a " +
+                         "recording_info_t on " + std::string(kRecordingInfoChannel) +
+                         " (a log of sensor messages replays with rtfuse-replay --log)");
+    return false;
+  }
+  std::string why;
+  if (!decode_recording_info(ev.data, static_cast<int>(ev.size), &rec.info, &why)) {
+    set_error(error, "file " + path + ": event " + std::to_string(ev.event_number) + " on " +
+                         std::string(kRecordingInfoChannel) + ": " + why);
+    return false;
+  }
+  rec.events = 1;
+
+  HalRecordCodec codec(rec.info.devices);
+  for (const std::string& name : rec.info.streams) {
+    rec.streams.push_back(std::make_unique<hal::mock::ReplayStream>(name));
+  }
+  for (std::size_t i = 0; i < rec.info.devices.size(); ++i) {
+    const RecordedDevice& d = rec.info.devices[i];
+    for (auto& s : rec.streams) s->set_device_name(static_cast<std::uint8_t>(i), d.name);
+  }
+  std::vector<bool> holed(rec.streams.size(), false);
+  bool have_tick = false;
+  std::int64_t last_seq = 0;
+
+  auto undecodable = [&](const LogEvent& e, const std::string& reason) {
+    set_error(error, "file " + path + ": event " + std::to_string(e.event_number) + " on channel " +
+                         std::string(e.channel) + " cannot be decoded: " + reason);
+    return false;
+  };
+
+  for (;;) {
+    st = reader.next(&ev, &read_error);
+    if (st == ReadStatus::kEnd) break;
+    if (st == ReadStatus::kError) {
+      const bool truncated = read_error.find("the log ends mid-event") != std::string::npos;
+      if (!truncated) {
+        set_error(error, read_error);
+        return false;
+      }
+      const std::int64_t complete = reader.events_read();
+      const std::string what = "file " + path + ": truncated after event " + std::to_string(complete - 1) +
+                               ", the recorder was probably killed";
+      if (!options.allow_truncated) {
+        set_error(error, what + ": replay the first " + std::to_string(complete) +
+                             " events with --allow-truncated (" + read_error + ")");
+        return false;
+      }
+      rec.truncated = true;
+      rec.warnings.push_back(what + ": replaying its first " + std::to_string(complete) + " events");
+      break;
+    }
+    ++rec.events;
+    const int size = static_cast<int>(ev.size);
+    if (starts_with(ev.channel, kHalChannelPrefix)) {
+      BusEvent bus;
+      if (!codec.decode(ev.channel, ev.data, size, &bus, &why)) return undecodable(ev, why);
+      const auto stream = static_cast<std::size_t>(rec.info.devices[bus.device].stream);
+      if (holed[stream]) continue;
+      if (bus.lost_before > 0) {
+        // The calls lost before this one are unknown: nothing after them on
+        // this thread can be replayed faithfully.
+        holed[stream] = true;
+        rec.lost_events += bus.lost_before;
+        rec.streams[stream]->mark_hole(ev.event_number, bus.lost_before);
+        rec.warnings.push_back("stream '" + rec.info.streams[stream] + "': the recorder lost " +
+                               std::to_string(bus.lost_before) + " events before event " +
+                               std::to_string(ev.event_number) +
+                               " (its ring was full): this stream replays only up to there");
+        continue;
+      }
+      rec.streams[stream]->append(bus, ev.event_number);
+    } else if (ev.channel == kLoopTickChannel) {
+      LoopTick tick;
+      if (!HalRecordCodec::decode_tick(ev.data, size, &tick, &why)) return undecodable(ev, why);
+      if (have_tick && tick.seq != last_seq + 1) {
+        if (tick.seq <= last_seq) return undecodable(ev, "tick seq " + std::to_string(tick.seq) + " after " +
+                                                             std::to_string(last_seq) + " goes backwards");
+        rec.missing_ticks += tick.seq - last_seq - 1;
+      }
+      have_tick = true;
+      last_seq = tick.seq;
+      rec.ticks.push_back(std::move(tick));
+    } else if (starts_with(ev.channel, kRecordChannelPrefix)) {
+      return undecodable(ev, ev.channel == kRecordingInfoChannel
+                                 ? std::string("a second recording_info_t (two recordings concatenated?)")
+                                 : std::string("unknown record channel (written by a newer rtfuse?)"));
+    } else {
+      rec.outputs.push_back(RecordedOutput{std::string(ev.channel), ev.timestamp_us, ev.event_number,
+                                           std::vector<std::uint8_t>(ev.data, ev.data + ev.size)});
+    }
+  }
+  if (rec.missing_ticks > 0) {
+    rec.warnings.push_back(std::to_string(rec.missing_ticks) +
+                           " loop ticks are missing (the recorder's tick ring was full)");
+  }
+  *out = std::move(rec);
+  return true;
+}
+
+}  // namespace rtfuse::transport

@@ -1,0 +1,154 @@
+#pragma once
+// HAL-level recordings (rtfused --record) as LCM logs, and loading them back
+// for rtfuse-replay.
+//
+// A recording is an lcm-logger file whose first event is a recording_info_t
+// on rtfuse/rec/info (format version, config, the device table: name, kind
+// and producing thread of every recorded bus). Then, in whatever order the
+// recorder drained its rings: one hal_can_t / hal_i2c_t / hal_gpio_t /
+// hal_clock_t per bus call on rtfuse/hal/<device name>, one loop_tick_t per
+// loop tick on rtfuse/rec/tick, and the published outputs on their own
+// channels. Events of one thread (stream) are in call order.
+//
+// HalRecordCodec turns a hal::BusEvent into LCM bytes in a caller buffer and
+// back (a canonical event round-trips byte for byte). Its message objects
+// persist, so encoding allocates only until the largest message was seen once.
+#include <cstddef>
+#include <cstdint>
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/time.hpp"
+#include "hal/bus_event.hpp"
+#include "hal/mock/replay_stream.hpp"
+#include "transport/event_log.hpp"
+
+namespace rtfuse::transport {
+
+// Bump when a rtfuse/hal/* or rtfuse/rec/* record changes meaning or layout.
+constexpr std::int32_t kHalRecordFormatVersion = 1;
+
+constexpr std::string_view kRecordingInfoChannel = "rtfuse/rec/info";
+constexpr std::string_view kLoopTickChannel = "rtfuse/rec/tick";
+constexpr std::string_view kRecordChannelPrefix = "rtfuse/rec/";
+constexpr std::string_view kHalChannelPrefix = "rtfuse/hal/";
+
+constexpr int kMaxRecordedDevices = 64;
+constexpr int kMaxRecordedStreams = 16;
+constexpr std::size_t kMaxDeviceNameLength = 48;
+constexpr int kMaxTickSensors = 64;
+// Largest encoded bus event (a receive of 16 frames on a 48-character device
+// name is under 500 bytes).
+constexpr int kMaxHalRecordSize = 1024;
+
+enum class DeviceKind : std::uint8_t { kCan, kI2c, kGpioEdge, kGpioOutput, kClock };
+const char* to_string(DeviceKind k) noexcept;
+// The bus call kinds a device of this kind records.
+bool records(DeviceKind device, hal::BusEventKind call) noexcept;
+
+struct RecordedDevice {
+  std::string name;  // "can0", "i2c-1", "imu-drdy", "imu-clock"; channel rtfuse/hal/<name>
+  DeviceKind kind = DeviceKind::kCan;
+  int stream = 0;  // index into RecordingInfo::streams of the thread that uses it
+};
+
+struct RecordingInfo {
+  std::int32_t format_version = kHalRecordFormatVersion;
+  TimeNs start_ns = 0;
+  std::string rtfuse_version;
+  std::string config_path;
+  std::string config_text;
+  std::int64_t config_hash = 0;  // config_text_hash(config_text)
+  std::vector<std::string> streams;  // producing threads: "loop", "imu"
+  std::vector<RecordedDevice> devices;  // index = hal::BusEvent::device
+};
+
+// FNV-1a (64-bit) of the config text.
+std::int64_t config_text_hash(std::string_view text) noexcept;
+
+// Device names non-empty, at most kMaxDeviceNameLength, unique, without '/'
+// or spaces; stream indices valid; counts within the limits above.
+bool validate(const RecordingInfo& info, std::string* error);
+
+std::vector<std::uint8_t> encode_recording_info(const RecordingInfo& info);
+// Fails on bytes that are not a recording_info_t, on another format version
+// (named, with the fix), and on an invalid device table.
+bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::string* error);
+
+struct LoopTick {
+  TimeNs time_ns = 0;
+  std::int64_t seq = 0;
+  std::vector<std::int64_t> consumed;  // per sensor, cumulative up to and including this tick
+};
+
+class HalRecordCodec {
+ public:
+  explicit HalRecordCodec(std::vector<RecordedDevice> devices);
+  ~HalRecordCodec();
+  HalRecordCodec(const HalRecordCodec&) = delete;
+  HalRecordCodec& operator=(const HalRecordCodec&) = delete;
+
+  // "rtfuse/hal/<name>", or "" for an index outside the table.
+  std::string_view channel(std::uint8_t device) const noexcept;
+  // Device index of a rtfuse/hal/* channel, -1 when no device has it.
+  int device_of(std::string_view channel) const noexcept;
+
+  // Bytes written into buf, or -1: unknown device, a call kind the device
+  // does not record, or capacity too small (kMaxHalRecordSize always fits).
+  int encode(const hal::BusEvent& ev, std::uint8_t* buf, int capacity);
+  // The event on `channel` back into *out (canonical). False with a reason
+  // (wrong type, bad length, impossible value) on anything else.
+  bool decode(std::string_view channel, const void* data, int size, hal::BusEvent* out, std::string* error);
+
+  // loop_tick_t; -1 when n is outside 0..kMaxTickSensors or it does not fit.
+  int encode_tick(TimeNs time_ns, std::int64_t seq, const std::int64_t* consumed, int n, std::uint8_t* buf,
+                  int capacity);
+  static bool decode_tick(const void* data, int size, LoopTick* out, std::string* error);
+
+ private:
+  struct Messages;  // the lcm-gen types stay out of this header
+  std::vector<RecordedDevice> devices_;
+  std::vector<std::string> channels_;
+  std::unique_ptr<Messages> msgs_;
+};
+
+// --- loading a whole recording (rtfuse-replay; allocates freely) -----------
+
+struct RecordedOutput {
+  std::string channel;
+  std::int64_t utime = 0;         // the log event's timestamp
+  std::int64_t event_number = 0;  // in the log
+  std::vector<std::uint8_t> bytes;
+};
+
+struct HalRecording {
+  RecordingInfo info;
+  // One per info.streams entry, in that order, with every device's name set.
+  std::vector<std::unique_ptr<hal::mock::ReplayStream>> streams;
+  std::vector<LoopTick> ticks;
+  std::vector<RecordedOutput> outputs;
+  std::int64_t events = 0;         // log events loaded
+  bool truncated = false;          // the log ends mid-event (loaded with allow_truncated)
+  std::int64_t lost_events = 0;    // bus events the recorder had no room for
+  std::int64_t missing_ticks = 0;  // gaps in the tick sequence
+  std::vector<std::string> warnings;  // one line each: truncation, holes, missing ticks
+};
+
+struct HalRecordingOptions {
+  // Keep the complete events of a log that ends mid-event (a killed recorder).
+  bool allow_truncated = false;
+};
+
+// Reads the whole log from an open reader. False with one error naming the
+// file, the event number and channel, and the likely fix when: the first
+// event is not a recording_info_t (not a recording), its format version is
+// not kHalRecordFormatVersion, the log is truncated (unless allowed), an
+// event cannot be decoded, or the log is corrupt.
+// A stream whose recorder lost events (ring overflow) is loaded up to the
+// hole; its end-of-stream report says so.
+bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& options, HalRecording* out,
+                        std::string* error);
+
+}  // namespace rtfuse::transport
