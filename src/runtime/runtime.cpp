@@ -10,9 +10,18 @@
 namespace rtfuse {
 
 std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, std::string* error) {
+  return create(cfg, HalBuses{}, error);
+}
+
+std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuses& buses, std::string* error) {
   std::unique_ptr<Runtime> rt(new Runtime());
   rt->core_ = FusionCore::create(cfg, error);
   if (!rt->core_) return nullptr;
+  if (cfg.hardware.can.enabled || cfg.hardware.mpu.enabled) {
+    rt->hardware_ = Hardware::create(buses, *rt->core_, error);
+    if (!rt->hardware_) return nullptr;
+    rt->core_->set_devices(rt->hardware_.get());
+  }
   rt->publisher_ = std::make_unique<Publisher>(rt->core_->config());
   rt->lcm_ = transport::LcmNode::create(cfg.lcm_url, error);
   if (!rt->lcm_) return nullptr;
@@ -47,6 +56,9 @@ bool Runtime::start(std::string* error, std::string* warnings) {
     }
     *warnings += mem.warnings;
   }
+  // Devices answer before anything runs: a missing chip or a bus that
+  // refuses the NMT start stops here with the device named.
+  if (hardware_ && !hardware_->start(monotonic_now_ns(), error)) return false;
   running_.store(true);
   // The loop thread applies its own scheduling; start() waits for its verdict
   // so a required-but-refused setting stops the process before it runs.
@@ -65,6 +77,7 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   }
   pub_ = std::thread(&Runtime::publisher_thread, this);
   lcmin_ = std::thread(&Runtime::input_thread, this);
+  if (hardware_ && hardware_->has_imu()) imu_ = std::thread(&Runtime::imu_thread, this);
   return true;
 }
 
@@ -73,6 +86,7 @@ void Runtime::stop() {
   if (loop_.joinable()) loop_.join();
   if (pub_.joinable()) pub_.join();
   if (lcmin_.joinable()) lcmin_.join();
+  if (imu_.joinable()) imu_.join();
 }
 
 Snapshot Runtime::latest() const {
@@ -125,6 +139,15 @@ void Runtime::input_thread() {
   while (running_.load(std::memory_order_relaxed)) {
     // Bounded wait so a stop request is seen within 50 ms.
     lcm_->handle_timeout(50);
+  }
+}
+
+void Runtime::imu_thread() {
+  name_this_thread("rtfuse-imu");
+  while (running_.load(std::memory_order_relaxed)) {
+    // A 50 ms edge wait bounds how long a stop request waits; a missing edge
+    // is the driver's to count, not a reason to leave.
+    hardware_->imu_step(50'000'000);
   }
 }
 

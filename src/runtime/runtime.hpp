@@ -1,7 +1,7 @@
 #pragma once
 // The live runtime: the fixed-rate loop thread (rtfuse-loop), the publisher
-// thread (rtfuse-pub) and the LCM input thread (rtfuse-lcmin) around one
-// FusionCore. Everything is allocated in create(); the threads allocate
+// thread (rtfuse-pub), the LCM input thread (rtfuse-lcmin) and, with an IMU
+// driver, the IMU thread (rtfuse-imu) around one FusionCore. Everything is allocated in create(); the threads allocate
 // nothing once running.
 #include <atomic>
 #include <memory>
@@ -9,6 +9,8 @@
 #include <thread>
 
 #include "runtime/fusion_core.hpp"
+#include "runtime/hal_buses.hpp"
+#include "runtime/hardware.hpp"
 #include "runtime/publisher.hpp"
 #include "transport/lcm_node.hpp"
 
@@ -16,7 +18,10 @@ namespace rtfuse {
 
 class Runtime {
  public:
+  // buses: where the configured drivers find their devices (none needed
+  // without [can] / [mpu]).
   static std::unique_ptr<Runtime> create(const RuntimeConfig& cfg, std::string* error);
+  static std::unique_ptr<Runtime> create(const RuntimeConfig& cfg, const HalBuses& buses, std::string* error);
   ~Runtime();
 
   // Applies the real-time settings and starts the threads. Returns false (and
@@ -37,16 +42,18 @@ class Runtime {
   void loop_thread();
   void publisher_thread();
   void input_thread();
+  void imu_thread();
   static void on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
 
   std::unique_ptr<FusionCore> core_;
   std::unique_ptr<Publisher> publisher_;
   std::unique_ptr<transport::LcmNode> lcm_;
+  std::unique_ptr<Hardware> hardware_;
   std::atomic<bool> running_{false};
   std::atomic<bool> steady_{false};
   std::atomic<bool> rt_failed_{false};
   std::string rt_warnings_;
-  std::thread loop_, pub_, lcmin_;
+  std::thread loop_, pub_, lcmin_, imu_;
 };
 
 }  // namespace rtfuse
