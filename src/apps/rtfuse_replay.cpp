@@ -1,5 +1,11 @@
 // rtfuse-replay: runs the runtime in lockstep with an LCM event log, as fast
 // as the CPU allows, and prints the final state as one JSON line.
+//
+// Two kinds of log: an ordinary one (lcm-logger, rosbag_to_lcm.py) whose
+// input channels are decoded as live; or a HAL recording (rtfused --record,
+// rtfuse-sim), replayed through the drivers on replay buses, checked call by
+// call against the recording and output by output against what was
+// published when it was made.
 #include <unistd.h>
 
 #include <cinttypes>
@@ -9,18 +15,20 @@
 #include <CLI/CLI.hpp>
 
 #include "runtime/config_loader.hpp"
+#include "runtime/hal_replay.hpp"
 #include "runtime/replay.hpp"
+#include "transport/hal_record_codec.hpp"
 
 namespace {
 
-void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::ReplayResult& r) {
-  const rtfuse::Snapshot& s = r.final;
+void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::Snapshot& s, std::int64_t events, std::int64_t ticks,
+                std::int64_t published, const std::string& extra) {
   static const char* kKeys[] = {"x", "y", "z", "roll", "pitch", "yaw", "vx", "vy", "vz"};
   std::printf("{");
   for (int i = 0; i < 9; ++i) std::printf("\"%s\": %.17g, ", kKeys[i], s.state[i]);
   std::printf("\"initialized\": %s, \"events\": %" PRId64 ", \"ticks\": %" PRId64 ", \"published\": %" PRId64
               ", \"unknown_channel_messages\": %" PRId64 ", \"sensors\": {",
-              s.initialized ? "true" : "false", r.events, r.ticks, r.published, s.unknown_channel_messages);
+              s.initialized ? "true" : "false", events, ticks, published, s.unknown_channel_messages);
   for (int i = 0; i < s.num_sensors; ++i) {
     const rtfuse::SensorStats& st = s.sensors[i];
     const std::int64_t rejected = st.rejected_mahalanobis + st.rejected_invalid + st.rejected_stale +
@@ -33,7 +41,97 @@ void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::ReplayResult& r)
                 st.rejected_mahalanobis, st.rejected_invalid, st.rejected_stale, st.rejected_overflow,
                 st.decode_errors, st.yaw_conflicts);
   }
-  std::printf("}}\n");
+  std::printf("}%s}\n", extra.c_str());
+}
+
+bool is_hal_recording(const std::string& path) {
+  rtfuse::transport::EventLogReader in;
+  rtfuse::transport::LogEvent ev;
+  std::string error;
+  return in.open(path, &error) && in.next(&ev, &error) == rtfuse::transport::ReadStatus::kEvent &&
+         ev.channel == rtfuse::transport::kRecordingInfoChannel;
+}
+
+bool read_text(const std::string& path, std::string* text) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  char buf[1 << 14];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
+  std::fclose(f);
+  return true;
+}
+
+int replay_recording(const std::string& log_path, const std::string& config_path, const std::string& out_path,
+                     bool allow_truncated, bool tty) {
+  rtfuse::transport::EventLogReader in;
+  std::string error;
+  if (!in.open(log_path, &error)) {
+    std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
+    return 1;
+  }
+  rtfuse::transport::HalRecording rec;
+  rtfuse::transport::HalRecordingOptions options;
+  options.allow_truncated = allow_truncated;
+  if (!rtfuse::transport::load_hal_recording(in, options, &rec, &error)) {
+    std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
+    return 1;
+  }
+  for (const std::string& w : rec.warnings) std::fprintf(stderr, "rtfuse-replay: warning: %s\n", w.c_str());
+  // The recording carries its configuration; another one must be the same.
+  std::string text = rec.info.config_text;
+  std::string source = rec.info.config_path;
+  if (!config_path.empty()) {
+    std::string given;
+    if (!read_text(config_path, &given)) {
+      std::fprintf(stderr, "rtfuse-replay: cannot read %s\n", config_path.c_str());
+      return 2;
+    }
+    const std::string mismatch = rtfuse::check_recording_config(rec.info, given, config_path);
+    if (!mismatch.empty()) {
+      std::fprintf(stderr, "rtfuse-replay: %s\n", mismatch.c_str());
+      return 2;
+    }
+    text = given;
+    source = config_path;
+  }
+  const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(text, source);
+  if (!loaded.config) {
+    for (const auto& e : loaded.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
+    return 2;
+  }
+  const rtfuse::RuntimeConfig& cfg = *loaded.config;
+  rtfuse::transport::EventLogWriter out;
+  if (!out_path.empty() && !out.open(out_path, &error)) {
+    std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
+    return 1;
+  }
+  const rtfuse::HalReplayResult r = rtfuse::replay_hal_recording(
+      rec, cfg, out_path.empty() ? nullptr : &out, [tty](const rtfuse::HalReplayProgress& p) {
+        if (tty) std::fprintf(stderr, "\rreplay: tick %" PRId64 " of %" PRId64 "\033[K", p.ticks, p.total_ticks);
+      });
+  if (tty) std::fprintf(stderr, "\n");
+  if (!out_path.empty() && !out.close(&error) && r.ok) {
+    std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
+    return 1;
+  }
+  if (!r.note.empty()) std::fprintf(stderr, "rtfuse-replay: %s\n", r.note.c_str());
+  if (!r.ok) {
+    std::fprintf(stderr, "rtfuse-replay: %s\n", r.error.c_str());
+    return r.diverged ? 3 : 1;
+  }
+  char extra[512];
+  std::snprintf(extra, sizeof extra,
+                ", \"recording\": {\"outputs_compared\": %" PRId64 ", \"outputs_identical\": %" PRId64
+                ", \"recorded_not_reproduced\": %" PRId64 ", \"ended_early\": %s}",
+                r.compared, r.identical, r.recorded_not_reproduced, r.ended_early ? "true" : "false");
+  print_json(cfg, r.final, rec.events, r.ticks, r.published, extra);
+  if (!r.first_mismatch.empty()) {
+    std::fprintf(stderr, "rtfuse-replay: the replay does not reproduce the recorded outputs: %s\n",
+                 r.first_mismatch.c_str());
+    return 4;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -42,9 +140,13 @@ int main(int argc, char** argv) {
   CLI::App app{"rtfuse-replay: run rtfuse in lockstep with an LCM log (lcm-logger format)"};
   std::string config_path, log_path, out_path;
   bool quiet = false;
-  app.add_option("-c,--config", config_path, "TOML config")->required();
+  bool allow_truncated = false;
+  app.add_option("-c,--config", config_path,
+                 "TOML config (required for an ordinary log; a HAL recording carries its own)");
   app.add_option("-l,--log", log_path, "input LCM log")->required();
   app.add_option("-o,--out", out_path, "write the published channels to this LCM log");
+  app.add_flag("--allow-truncated", allow_truncated,
+               "replay the complete part of a HAL recording whose recorder was killed");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   try {
     app.parse(argc, argv);
@@ -53,6 +155,13 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
+  const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
+  if (is_hal_recording(log_path)) return replay_recording(log_path, config_path, out_path, allow_truncated, tty);
+  if (config_path.empty()) {
+    std::fprintf(stderr, "rtfuse-replay: %s is not a HAL recording: give its configuration with --config\n",
+                 log_path.c_str());
+    return 2;
+  }
   const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_file(config_path);
   if (!loaded.config) {
     for (const auto& e : loaded.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
@@ -75,7 +184,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
     return 1;
   }
-  const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
   const rtfuse::ReplayResult r = replay->run(in, out_path.empty() ? nullptr : &out,
                                              [tty](const rtfuse::ReplayProgress& p) {
                                                if (tty) {
@@ -92,6 +200,6 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtfuse-replay: %s\n", r.error.c_str());
     return 1;
   }
-  print_json(cfg, r);
+  print_json(cfg, r.final, r.events, r.ticks, r.published, "");
   return 0;
 }

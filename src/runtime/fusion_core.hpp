@@ -37,6 +37,8 @@ class FusionCore {
   // One loop iteration at loop time `now`. Never allocates, locks or blocks.
   void tick(TimeNs now, const LoopStats& loop) noexcept;
   const SeqLock<Snapshot>& snapshot() const { return snapshot_; }
+  // The snapshot of the last tick, for the loop thread itself (no seqlock).
+  const Snapshot& last_snapshot() const { return scratch_; }
   const est::Filter& filter() const { return *filter_; }
 
   // Not owned; set before the loop starts.

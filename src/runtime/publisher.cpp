@@ -213,14 +213,34 @@ Publisher::~Publisher() = default;
 
 std::int64_t Publisher::encode_failures() const { return impl_->encode_failures; }
 
+std::uint32_t Publisher::schedule(const Snapshot& s, TimeNs now) noexcept {
+  Impl& m = *impl_;
+  std::uint32_t due = 0;
+  if (s.initialized && m.odometry.schedule.due(now)) due |= kOdometry;
+  if (s.initialized && m.pose.schedule.due(now)) due |= kPose;
+  if (s.initialized && m.tf.schedule.due(now)) due |= kTf;
+  if (s.initialized && m.state.schedule.due(now)) due |= kState;
+  const WheelOdometrySnapshot& w = s.wheel_odometry;
+  if (w.valid && w.stamp_ns != m.last_wheel_stamp && m.wheel_odometry.schedule.due(now)) {
+    m.last_wheel_stamp = w.stamp_ns;
+    due |= kWheelOdometry;
+  }
+  if (m.diagnostics.schedule.due(now)) due |= kDiagnostics;
+  return due;
+}
+
 int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
+  return publish(s, schedule(s, now), now, sink);
+}
+
+int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, MessageSink& sink) noexcept {
   Impl& m = *impl_;
   int sent = 0;
   // The estimate's own time, not the publishing time: consumers interpolate
   // and look up transforms by it, as they would with robot_localization.
   const std::int64_t utime = ns_to_utime(s.stamp_ns);
 
-  if (s.initialized && m.odometry.schedule.due(now)) {
+  if (due & kOdometry) {
     auto& o = m.odometry.msg;
     o.header.utime = utime;
     o.header.seq = m.odometry.next_seq();
@@ -229,7 +249,7 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
     sent += m.emit(m.odometry, now, sink);
   }
 
-  if (s.initialized && m.pose.schedule.due(now)) {
+  if (due & kPose) {
     auto& o = m.pose.msg;
     o.header.utime = utime;
     o.header.seq = m.pose.next_seq();
@@ -237,7 +257,7 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
     sent += m.emit(m.pose, now, sink);
   }
 
-  if (s.initialized && m.tf.schedule.due(now)) {
+  if (due & kTf) {
     auto& t = m.tf.msg.transforms[0];
     t.header.utime = utime;
     t.header.seq = m.tf.next_seq();
@@ -252,7 +272,7 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
     sent += m.emit(m.tf, now, sink);
   }
 
-  if (s.initialized && m.state.schedule.due(now)) {
+  if (due & kState) {
     auto& o = m.state.msg;
     o.header.utime = utime;
     o.header.seq = m.state.next_seq();
@@ -263,8 +283,7 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
   }
 
   const WheelOdometrySnapshot& w = s.wheel_odometry;
-  if (w.valid && w.stamp_ns != m.last_wheel_stamp && m.wheel_odometry.schedule.due(now)) {
-    m.last_wheel_stamp = w.stamp_ns;
+  if (due & kWheelOdometry) {
     auto& o = m.wheel_odometry.msg;
     o.header.utime = ns_to_utime(w.stamp_ns);
     o.header.seq = m.wheel_odometry.next_seq();
@@ -279,7 +298,7 @@ int Publisher::poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept {
     sent += m.emit(m.wheel_odometry, now, sink);
   }
 
-  if (m.diagnostics.schedule.due(now)) {
+  if (due & kDiagnostics) {
     auto& d = m.diagnostics.msg;
     // Diagnostics describe the process now, not the estimate.
     d.header.utime = ns_to_utime(now);

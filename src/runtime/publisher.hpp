@@ -30,9 +30,24 @@ class Publisher {
   Publisher(const Publisher&) = delete;
   Publisher& operator=(const Publisher&) = delete;
 
-  // Publishes every enabled output that is due at `now` (all of them on the
-  // first call); returns how many messages the sink accepted. State outputs
-  // wait for s.initialized; diagnostics do not.
+  enum OutputBit : std::uint32_t {
+    kOdometry = 1u << 0,
+    kPose = 1u << 1,
+    kTf = 1u << 2,
+    kState = 1u << 3,
+    kWheelOdometry = 1u << 4,
+    kDiagnostics = 1u << 5,
+  };
+  // Which outputs are due at `now` for this snapshot (all of them on the
+  // first call), consuming their slots. State outputs wait for
+  // s.initialized; diagnostics do not. The daemon's loop calls it on tick
+  // time, so the set of published snapshots is a function of the ticks
+  // alone and a replay reproduces it exactly.
+  std::uint32_t schedule(const Snapshot& s, TimeNs now) noexcept;
+  // Encodes and hands to the sink the outputs in `due`; returns how many
+  // messages the sink accepted. `now` stamps diagnostics only.
+  int publish(const Snapshot& s, std::uint32_t due, TimeNs now, MessageSink& sink) noexcept;
+  // schedule() then publish(), on one thread (replay, tests).
   int poll(const Snapshot& s, TimeNs now, MessageSink& sink) noexcept;
 
   // Messages that did not fit their buffer (never expected: sizes are fixed).

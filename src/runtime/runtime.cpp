@@ -14,9 +14,21 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, std::string* 
 }
 
 std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuses& buses, std::string* error) {
+  return create(cfg, buses, std::string(), std::string(), error);
+}
+
+std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuses& buses_in,
+                                         const std::string& record_path, const std::string& config_text,
+                                         std::string* error) {
   std::unique_ptr<Runtime> rt(new Runtime());
   rt->core_ = FusionCore::create(cfg, error);
   if (!rt->core_) return nullptr;
+  HalBuses buses = buses_in;
+  if (!record_path.empty()) {
+    rt->tap_ = RecordingTap::create(record_path, rt->core_->config(), config_text, buses, rt->clock_, error);
+    if (!rt->tap_) return nullptr;
+    buses = rt->tap_->buses();
+  }
   if (cfg.hardware.can.enabled || cfg.hardware.mpu.enabled) {
     rt->hardware_ = Hardware::create(buses, *rt->core_, error);
     if (!rt->hardware_) return nullptr;
@@ -58,6 +70,7 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   }
   // Devices answer before anything runs: a missing chip or a bus that
   // refuses the NMT start stops here with the device named.
+  if (tap_ && !tap_->recorder().start(error)) return false;
   if (hardware_ && !hardware_->start(monotonic_now_ns(), error)) return false;
   running_.store(true);
   // The loop thread applies its own scheduling; start() waits for its verdict
@@ -81,12 +94,14 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   return true;
 }
 
-void Runtime::stop() {
-  if (!running_.exchange(false)) return;
+bool Runtime::stop(std::string* error) {
+  running_.store(false);
   if (loop_.joinable()) loop_.join();
   if (pub_.joinable()) pub_.join();
   if (lcmin_.joinable()) lcmin_.join();
   if (imu_.joinable()) imu_.join();
+  // Producers are gone: the recorder drains what is left and closes.
+  return tap_ ? tap_->recorder().stop(error) : true;
 }
 
 Snapshot Runtime::latest() const {
@@ -105,32 +120,48 @@ void Runtime::loop_thread() {
   }
   LoopTimer timer(core_->config().rate_hz, monotonic_now_ns());
   // One tick before declaring steady state, so first-touch effects are over.
-  core_->tick(monotonic_now_ns(), timer.stats());
+  loop_tick(monotonic_now_ns(), timer.stats());
   steady_.store(true, std::memory_order_release);
   while (running_.load(std::memory_order_relaxed)) {
     sleep_until(timer.deadline());
     const TimeNs woke = monotonic_now_ns();
-    core_->tick(woke, timer.stats());
+    loop_tick(woke, timer.stats());
     timer.record(woke, monotonic_now_ns());
   }
 }
 
+void Runtime::loop_tick(TimeNs now, const LoopStats& stats) noexcept {
+  core_->tick(now, stats);
+  const Snapshot& snap = core_->last_snapshot();
+  if (tap_) {
+    tap_->recorder().record_tick(now, snap.seq, core_->consumed(), core_->config().num_sensors);
+  }
+  const std::uint32_t due = publisher_->schedule(snap, now);
+  if (due == 0) return;
+  job_.snapshot = snap;
+  job_.due = due;
+  if (!publish_jobs_.try_push(job_)) publish_drops_.fetch_add(1, std::memory_order_relaxed);
+}
+
 void Runtime::publisher_thread() {
   name_this_thread("rtfuse-pub");
-  LcmSink sink(*lcm_);
-  const PublishConfig& p = core_->config().publish;
-  const double fastest = std::max({p.odometry_rate_hz, p.pose_rate_hz, p.tf_rate_hz, p.state_rate_hz,
-                                   p.diagnostics_rate_hz, 1.0});
-  // Wake at twice the fastest output rate (at most 1 kHz) so no output is
-  // late by more than half its period.
-  const TimeNs period = std::max<TimeNs>(sec_to_ns(0.5 / fastest), 1'000'000);
-  Snapshot snap;
+  LcmSink lcm_sink(*lcm_);
+  std::unique_ptr<runtime::RecordingSink> recording;
+  if (tap_) recording = std::make_unique<runtime::RecordingSink>(lcm_sink, tap_->recorder());
+  MessageSink& sink = recording ? static_cast<MessageSink&>(*recording) : lcm_sink;
+  // The loop queues what is due; a 1 ms wake-up keeps outputs within a
+  // millisecond of their tick at any rate.
+  const TimeNs period = 1'000'000;
   TimeNs next = monotonic_now_ns();
-  while (running_.load(std::memory_order_relaxed)) {
+  for (;;) {
+    const bool running = running_.load(std::memory_order_acquire);
+    while (const PublishJob* job = publish_jobs_.peek()) {
+      publisher_->publish(job->snapshot, job->due, monotonic_now_ns(), sink);
+      publish_jobs_.pop();
+    }
+    if (!running) break;  // the loop has stopped: everything it queued is out
     next += period;
     sleep_until(next);
-    core_->snapshot().load(snap);
-    publisher_->poll(snap, monotonic_now_ns(), sink);
   }
 }
 

@@ -1,20 +1,36 @@
 #pragma once
 // The live runtime: the fixed-rate loop thread (rtfuse-loop), the publisher
 // thread (rtfuse-pub), the LCM input thread (rtfuse-lcmin) and, with an IMU
-// driver, the IMU thread (rtfuse-imu) around one FusionCore. Everything is allocated in create(); the threads allocate
-// nothing once running.
+// driver, the IMU thread (rtfuse-imu) around one FusionCore; with a
+// recording, the recorder's writer (rtfuse-rec). Everything is allocated in
+// create(); the threads allocate nothing once running.
+//
+// Which snapshots are published is decided by the loop on tick time
+// (Publisher::schedule) and handed to the publisher thread through a ring,
+// so the outputs are a function of the ticks alone: a replay of a recording
+// reproduces them byte for byte.
 #include <atomic>
 #include <memory>
 #include <string>
 #include <thread>
 
+#include "core/spsc_ring.hpp"
+#include "hal/linux/monotonic_clock.hpp"
 #include "runtime/fusion_core.hpp"
 #include "runtime/hal_buses.hpp"
 #include "runtime/hardware.hpp"
 #include "runtime/publisher.hpp"
+#include "runtime/recording_tap.hpp"
 #include "transport/lcm_node.hpp"
 
 namespace rtfuse {
+
+// A snapshot the loop wants published and which outputs of it (outside
+// Runtime: SpscRing needs the type complete).
+struct PublishJob {
+  Snapshot snapshot;
+  std::uint32_t due = 0;
+};
 
 class Runtime {
  public:
@@ -22,13 +38,20 @@ class Runtime {
   // without [can] / [mpu]).
   static std::unique_ptr<Runtime> create(const RuntimeConfig& cfg, std::string* error);
   static std::unique_ptr<Runtime> create(const RuntimeConfig& cfg, const HalBuses& buses, std::string* error);
+  // The same, recording every bus event, loop tick and output to
+  // record_path (empty: no recording). config_text goes into the recording.
+  static std::unique_ptr<Runtime> create(const RuntimeConfig& cfg, const HalBuses& buses,
+                                         const std::string& record_path, const std::string& config_text,
+                                         std::string* error);
   ~Runtime();
 
   // Applies the real-time settings and starts the threads. Returns false (and
   // *error) when a required setting is refused or a thread cannot start;
   // refused optional settings are written to *warnings.
   bool start(std::string* error, std::string* warnings);
-  void stop();
+  // Stops the threads; a recording is drained and closed (false and *error
+  // if it could not be written completely).
+  bool stop(std::string* error = nullptr);
 
   Snapshot latest() const;
   transport::LcmNode& lcm() { return *lcm_; }
@@ -36,10 +59,14 @@ class Runtime {
   // Set by the loop after its first steady tick; tests and tools use it to
   // know when start-up allocations are over.
   bool steady() const { return steady_.load(std::memory_order_acquire); }
+  // Snapshots the publisher thread could not take in time (ring full).
+  std::int64_t publish_drops() const { return publish_drops_.load(std::memory_order_relaxed); }
+  const RecordingTap* recording() const { return tap_.get(); }
 
  private:
   Runtime() = default;
   void loop_thread();
+  void loop_tick(TimeNs now, const LoopStats& stats) noexcept;
   void publisher_thread();
   void input_thread();
   void imu_thread();
@@ -49,6 +76,12 @@ class Runtime {
   std::unique_ptr<Publisher> publisher_;
   std::unique_ptr<transport::LcmNode> lcm_;
   std::unique_ptr<Hardware> hardware_;
+  std::unique_ptr<RecordingTap> tap_;
+  hal::MonotonicClock clock_;
+  // Snapshots are large: a few slots cover the publisher thread waking late.
+  SpscRing<PublishJob> publish_jobs_{8};
+  PublishJob job_;  // the loop's staging copy
+  std::atomic<std::int64_t> publish_drops_{0};
   std::atomic<bool> running_{false};
   std::atomic<bool> steady_{false};
   std::atomic<bool> rt_failed_{false};

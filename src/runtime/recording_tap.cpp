@@ -1,0 +1,86 @@
+#include "runtime/recording_tap.hpp"
+
+#include <algorithm>
+
+namespace rtfuse {
+namespace {
+
+// Channel-safe: "/dev/i2c-1" -> "i2c-1", no '/' or spaces.
+std::string device_name(std::string_view path, const char* fallback) {
+  const std::size_t slash = path.rfind('/');
+  std::string name(slash == std::string_view::npos ? path : path.substr(slash + 1));
+  std::replace(name.begin(), name.end(), ' ', '_');
+  return name.empty() ? std::string(fallback) : name;
+}
+
+}  // namespace
+
+std::string can_device_name(const RuntimeConfig& cfg) {
+  return device_name(cfg.hardware.can.interface.view(), "can");
+}
+std::string i2c_device_name(const RuntimeConfig& cfg) { return device_name(cfg.hardware.mpu.device.view(), "i2c"); }
+
+RecordingTap::~RecordingTap() = default;
+
+std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, const RuntimeConfig& cfg,
+                                                   const std::string& config_text, const HalBuses& inner,
+                                                   hal::Clock& clock, std::string* error) {
+  std::unique_ptr<RecordingTap> t(new RecordingTap());
+  transport::RecordingInfo info;
+  info.rtfuse_version = "rtfuse " RTFUSE_VERSION;
+  info.config_path = cfg.source;
+  info.config_text = config_text;
+  info.config_hash = transport::config_text_hash(config_text);
+  info.streams = {kLoopStream, kImuStream};
+  int can = -1, i2c = -1, drdy = -1, imu_clock = -1;
+  auto add = [&info](std::string name, transport::DeviceKind kind, int stream) {
+    info.devices.push_back({std::move(name), kind, stream});
+    return static_cast<int>(info.devices.size()) - 1;
+  };
+  if (inner.can != nullptr) can = add(can_device_name(cfg), transport::DeviceKind::kCan, 0);
+  if (inner.i2c != nullptr) i2c = add(i2c_device_name(cfg), transport::DeviceKind::kI2c, 1);
+  if (inner.drdy != nullptr) drdy = add("imu-drdy", transport::DeviceKind::kGpioEdge, 1);
+  if (inner.imu_clock != nullptr && inner.i2c != nullptr) {
+    imu_clock = add("imu-clock", transport::DeviceKind::kClock, 1);
+  }
+  runtime::RecorderRingSizes sizes;
+  // A second of the loop at 1 kHz and of a 1 kHz IMU, so a writer stalled
+  // by the disk for that long loses nothing.
+  sizes.bus_events = 8192;
+  sizes.ticks = 2048;
+  sizes.outputs = 512;
+  t->recorder_ = runtime::Recorder::create(path, info, sizes, error);
+  if (!t->recorder_) return nullptr;
+  runtime::Recorder& r = *t->recorder_;
+  HalBuses& b = t->buses_;
+  if (can >= 0) {
+    t->can_ = std::make_unique<hal::RecordingCanBus>(*inner.can, r.ring(0), static_cast<std::uint8_t>(can), &clock);
+    b.can = t->can_.get();
+  }
+  if (i2c >= 0) {
+    t->i2c_ = std::make_unique<hal::RecordingI2cBus>(*inner.i2c, r.ring(1), static_cast<std::uint8_t>(i2c), &clock);
+    b.i2c = t->i2c_.get();
+  }
+  if (drdy >= 0) {
+    t->drdy_ =
+        std::make_unique<hal::RecordingEdgeSource>(*inner.drdy, r.ring(1), static_cast<std::uint8_t>(drdy), &clock);
+    b.drdy = t->drdy_.get();
+  }
+  if (imu_clock >= 0) {
+    t->imu_clock_ =
+        std::make_unique<hal::RecordingClock>(*inner.imu_clock, r.ring(1), static_cast<std::uint8_t>(imu_clock));
+    b.imu_clock = t->imu_clock_.get();
+  }
+  return t;
+}
+
+std::int64_t RecordingTap::overflows() const {
+  std::int64_t n = 0;
+  if (can_) n += can_->overflows();
+  if (i2c_) n += i2c_->overflows();
+  if (drdy_) n += drdy_->overflows();
+  if (imu_clock_) n += imu_clock_->overflows();
+  return n;
+}
+
+}  // namespace rtfuse

@@ -1,0 +1,51 @@
+#pragma once
+// rtfused --record: the recorder plus the recording decorators around the
+// configuration's buses. The drivers are given buses() instead of the real
+// ones and never know they are recorded. Which device is on which thread is
+// fixed here and read back by hal_replay.cpp:
+//   stream "loop": the CAN bus (polled inside the tick);
+//   stream "imu":  the I2C bus, the data-ready line, the IMU thread's clock.
+#include <memory>
+#include <string>
+
+#include "hal/recording_can_bus.hpp"
+#include "hal/recording_clock.hpp"
+#include "hal/recording_gpio.hpp"
+#include "hal/recording_i2c_bus.hpp"
+#include "runtime/config.hpp"
+#include "runtime/hal_buses.hpp"
+#include "runtime/recorder.hpp"
+
+namespace rtfuse {
+
+constexpr const char* kLoopStream = "loop";
+constexpr const char* kImuStream = "imu";
+
+class RecordingTap {
+ public:
+  // config_text: the TOML the configuration came from, stored in the
+  // recording so a replay needs nothing else. clock stamps the bus events.
+  static std::unique_ptr<RecordingTap> create(const std::string& path, const RuntimeConfig& cfg,
+                                              const std::string& config_text, const HalBuses& inner,
+                                              hal::Clock& clock, std::string* error);
+  ~RecordingTap();
+  HalBuses buses() const { return buses_; }
+  runtime::Recorder& recorder() { return *recorder_; }
+  // Events the decorators could not queue (ring full), all devices.
+  std::int64_t overflows() const;
+
+ private:
+  RecordingTap() = default;
+  std::unique_ptr<runtime::Recorder> recorder_;
+  std::unique_ptr<hal::RecordingCanBus> can_;
+  std::unique_ptr<hal::RecordingI2cBus> i2c_;
+  std::unique_ptr<hal::RecordingEdgeSource> drdy_;
+  std::unique_ptr<hal::RecordingClock> imu_clock_;
+  HalBuses buses_;
+};
+
+// The device names a recording uses for a configuration's buses.
+std::string can_device_name(const RuntimeConfig& cfg);
+std::string i2c_device_name(const RuntimeConfig& cfg);
+
+}  // namespace rtfuse
