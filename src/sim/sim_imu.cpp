@@ -1,0 +1,149 @@
+#include "sim/sim_imu.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "geometry/rotation.hpp"
+#include "sim/counter_rng.hpp"
+
+namespace rtfuse::sim {
+
+namespace {
+
+hal::mock::MpuModel chip_model(SimImuModel m) noexcept {
+  switch (m) {
+    case SimImuModel::kMpu6500: return hal::mock::MpuModel::kMpu6500;
+    case SimImuModel::kMpu9250: return hal::mock::MpuModel::kMpu9250;
+    case SimImuModel::kMpu6050: break;
+  }
+  return hal::mock::MpuModel::kMpu6050;
+}
+
+// FS_SEL / AFS_SEL of a full-scale range, -1 if none matches.
+int gyro_fs_sel(int dps) noexcept {
+  return dps == 250 ? 0 : dps == 500 ? 1 : dps == 1000 ? 2 : dps == 2000 ? 3 : -1;
+}
+int accel_fs_sel(int g) noexcept { return g == 2 ? 0 : g == 4 ? 1 : g == 8 ? 2 : g == 16 ? 3 : -1; }
+
+}  // namespace
+
+SimImu::SimImu(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0)
+    : truth_(truth),
+      clock_(clock),
+      t0_(t0),
+      cfg_(scenario.imu),
+      seed_(scenario.seed),
+      period_ns_(1e9 / (scenario.imu.rate_hz > 0.0 ? scenario.imu.rate_hz : 1.0)),
+      // White noise of density d sampled at f has sigma d * sqrt(f / 2): the
+      // band up to Nyquist (the DLPF's band would be a refinement).
+      gyro_sigma_(scenario.imu.gyro_noise_density * std::sqrt(0.5 * 1e9 / period_ns_)),
+      accel_sigma_(scenario.imu.accel_noise_density * std::sqrt(0.5 * 1e9 / period_ns_)),
+      chip_(chip_model(scenario.imu.model)) {
+  const Eigen::Matrix3d r = geometry::rotation_from_rpy(cfg_.rpy_rad[0], cfg_.rpy_rad[1], cfg_.rpy_rad[2]);
+  for (int i = 0; i < 3; ++i) {
+    for (int j = 0; j < 3; ++j) r_[i][j] = r(i, j);
+  }
+  bus_.attach(cfg_.address, chip_);
+}
+
+SimImu::~SimImu() { bus_.detach(cfg_.address); }
+
+TimeNs SimImu::sample_time(std::int64_t k) const noexcept {
+  return t0_ + static_cast<TimeNs>(std::llround(static_cast<double>(k) * period_ns_));
+}
+
+std::int64_t SimImu::first_sample_at_or_after(TimeNs t) const noexcept {
+  if (t <= t0_) return 0;
+  auto k = static_cast<std::int64_t>(std::ceil(static_cast<double>(t - t0_) / period_ns_));
+  while (sample_time(k) < t) ++k;
+  while (k > 0 && sample_time(k - 1) >= t) --k;
+  return k;
+}
+
+ImuSample SimImu::ideal_sample(std::int64_t k) const noexcept {
+  const TruthState s = truth_.truth_at(ns_to_sec(sample_time(k) - t0_));
+  const double w = s.yaw_rate;
+  const double dw = s.yaw_accel;
+  const double px = cfg_.xyz_m[0];
+  const double py = cfg_.xyz_m[1];
+  // Specific force at the IMU's origin in base_link axes: the base's
+  // acceleration, the lever arm's tangential (dw x p) and centripetal
+  // (w x (w x p)) parts, and the floor pushing up against gravity.
+  const double f[3] = {s.accel_body[0] - dw * py - w * w * px, s.accel_body[1] + dw * px - w * w * py,
+                       s.accel_body[2] + hal::mock::mpu::kStandardGravity};
+  const double rate[3] = {0.0, 0.0, w};
+  ImuSample out;
+  for (int i = 0; i < 3; ++i) {  // IMU axes: the transpose of base_link <- IMU
+    out.accel_mps2[i] = r_[0][i] * f[0] + r_[1][i] * f[1] + r_[2][i] * f[2];
+    out.gyro_rad_s[i] = r_[0][i] * rate[0] + r_[1][i] * rate[1] + r_[2][i] * rate[2];
+  }
+  out.temperature_c = cfg_.temperature_c;
+  return out;
+}
+
+ImuSample SimImu::sample(std::int64_t k) const noexcept {
+  ImuSample s = ideal_sample(k);
+  const auto index = static_cast<std::uint64_t>(k);
+  for (int i = 0; i < 3; ++i) {
+    const auto axis = static_cast<std::uint64_t>(i);
+    s.gyro_rad_s[i] += cfg_.gyro_bias_rad_s[static_cast<std::size_t>(i)] +
+                       gyro_sigma_ * counter_normal(seed_, stream::kGyro + axis, index);
+    s.accel_mps2[i] += cfg_.accel_bias_mps2[static_cast<std::size_t>(i)] +
+                       accel_sigma_ * counter_normal(seed_, stream::kAccel + axis, index);
+  }
+  return s;
+}
+
+hal::HalStatus SimImu::wait_edge(TimeNs timeout_ns, hal::GpioEdge* out) noexcept {
+  const TimeNs now = clock_.now();
+  constexpr TimeNs kForever = std::numeric_limits<TimeNs>::max();
+  const TimeNs wait = std::max<TimeNs>(timeout_ns, 0);
+  const TimeNs deadline = wait > kForever - now ? kForever : now + wait;
+  // A reader further behind than the kernel's event queue finds only the
+  // most recent edges there; the older samples are gone.
+  const std::int64_t oldest_kept = first_sample_at_or_after(now) - kEdgeQueue;
+  if (next_ < oldest_kept) {
+    skipped_ += oldest_kept - next_;
+    next_ = oldest_kept;
+  }
+  // Bounded: one pass per sample period within the timeout.
+  for (;;) {
+    const TimeNs t = sample_time(next_);
+    if (t > deadline) {
+      clock_.sleep_until(deadline);
+      return hal::HalStatus::kTimeout;
+    }
+    clock_.sleep_until(t);
+    const ImuSample s = sample(next_);
+    ++next_;
+    if (chip_.set_sample(s.accel_mps2, s.gyro_rad_s, s.temperature_c)) {
+      ++edges_;
+      if (out != nullptr) *out = hal::GpioEdge{t, true};
+      return hal::HalStatus::kOk;
+    }
+  }
+}
+
+hal::HalStatus SimImu::read_registers(std::uint8_t address, std::uint8_t reg, std::uint8_t* buf, int n) noexcept {
+  return bus_.read_registers(address, reg, buf, n);
+}
+
+hal::HalStatus SimImu::write_register(std::uint8_t address, std::uint8_t reg, std::uint8_t value) noexcept {
+  return bus_.write_register(address, reg, value);
+}
+
+const char* SimImu::config_mismatch() const noexcept {
+  if (std::abs(chip_.sample_rate_hz() - cfg_.rate_hz) > 1e-6 * cfg_.rate_hz) {
+    return "the driver set a sample rate (SMPLRT_DIV, DLPF_CFG) other than the scenario's imu.rate_hz";
+  }
+  if (chip_.gyro_fs_sel() != gyro_fs_sel(cfg_.gyro_range_dps)) {
+    return "the driver set a gyro full scale other than the scenario's imu.gyro_range_dps";
+  }
+  if (chip_.accel_fs_sel() != accel_fs_sel(cfg_.accel_range_g)) {
+    return "the driver set an accelerometer full scale other than the scenario's imu.accel_range_g";
+  }
+  return nullptr;
+}
+
+}  // namespace rtfuse::sim

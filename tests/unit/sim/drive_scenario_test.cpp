@@ -1,0 +1,398 @@
+// Scenario files of the bus-level simulator: what they parse to, and that
+// every mistake is reported with its file, line, column and key.
+#include "sim/drive_scenario.hpp"
+
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <string>
+
+#include "sim/truth_trajectory.hpp"
+
+namespace rtfuse::sim {
+namespace {
+
+constexpr double kPi = 3.14159265358979323846;
+constexpr double kDeg = kPi / 180.0;
+
+// A valid scenario to which each test adds or changes lines.
+const std::string kRobot = R"(
+[robot]
+left_nodes = [1]
+right_nodes = [2]
+)";
+
+std::string load_error(const std::string& text) {
+  DriveScenario sc;
+  std::string error;
+  EXPECT_FALSE(load_drive_scenario_string(text, "t.toml", &sc, &error)) << text;
+  return error;
+}
+
+DriveScenario load_ok(const std::string& text) {
+  DriveScenario sc;
+  std::string error;
+  EXPECT_TRUE(load_drive_scenario_string(text, "t.toml", &sc, &error)) << error;
+  return sc;
+}
+
+TEST(DriveScenario, ShippedScenariosLoadAndCanBeDriven) {
+  for (const char* name : {"straight", "turns", "figure_eight", "slip", "dropout", "demo"}) {
+    const std::string path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/" + name + ".toml";
+    DriveScenario sc;
+    std::string error;
+    ASSERT_TRUE(load_drive_scenario(path, &sc, &error)) << error;
+    EXPECT_EQ(sc.source, path);
+    EXPECT_FALSE(sc.path.empty()) << name;
+    const TruthTrajectory truth(sc);
+    EXPECT_TRUE(truth.valid()) << name << ": " << truth.problem().message;
+    EXPECT_GT(truth.plan().end_time(), 5.0) << name;
+    EXPECT_GE(truth.duration_s(), truth.plan().end_time()) << name;
+  }
+  DriveScenario demo;
+  std::string error;
+  ASSERT_TRUE(load_drive_scenario(RTFUSE_SOURCE_DIR "/config/scenarios/demo.toml", &demo, &error)) << error;
+  const TruthTrajectory truth(demo);
+  // "A few minutes", with the figure eights, a spin, the slip episode and the
+  // dropout all inside the drive.
+  EXPECT_GT(truth.plan().end_time(), 120.0);
+  EXPECT_LE(truth.plan().end_time(), demo.duration_s);
+  ASSERT_EQ(demo.dropout_count, 1);
+  EXPECT_LT(demo.dropouts[0].start_s + demo.dropouts[0].duration_s, truth.plan().end_time());
+  ASSERT_EQ(demo.slip.episode_count, 1);
+  EXPECT_LT(demo.slip.episodes[0].start_s + demo.slip.episodes[0].duration_s, truth.plan().end_time());
+}
+
+TEST(DriveScenario, EverySegmentTypeParsesToSiUnits) {
+  const DriveScenario sc = load_ok(R"(
+duration_s = 300.0
+seed = 99
+[limits]
+max_accel_mps2 = 0.8
+max_yaw_accel_dps2 = 180.0
+[[path]]
+type = "straight"
+length_m = 3.0
+speed_mps = 1.5
+[[path]]
+type = "straight"
+duration_s = 4.0
+speed_mps = 0.5
+[[path]]
+type = "arc"
+radius_m = 2.0
+angle_deg = -45.0
+speed_mps = 1.0
+[[path]]
+type = "arc"
+yaw_rate_dps = 30.0
+angle_deg = 90.0
+speed_mps = 0.5
+[[path]]
+type = "spin"
+angle_deg = 180.0
+yaw_rate_dps = 45.0
+[[path]]
+type = "figure_eight"
+radius_m = 1.5
+laps = 2
+speed_mps = 0.7
+first_turn = "right"
+[[path]]
+type = "stop"
+duration_s = 1.5
+)" + kRobot);
+  EXPECT_EQ(sc.duration_s, 300.0);
+  EXPECT_EQ(sc.seed, 99u);
+  EXPECT_DOUBLE_EQ(sc.limits.max_accel_mps2, 0.8);
+  EXPECT_DOUBLE_EQ(sc.limits.max_yaw_accel_rad_s2, kPi);
+  ASSERT_EQ(sc.path.size(), 7u);
+  EXPECT_EQ(sc.path[0].type, SegmentType::kStraight);
+  EXPECT_DOUBLE_EQ(sc.path[0].length_m, 3.0);
+  EXPECT_DOUBLE_EQ(sc.path[0].speed_mps, 1.5);
+  EXPECT_DOUBLE_EQ(sc.path[1].length_m, 2.0);  // duration at cruise speed
+  EXPECT_EQ(sc.path[2].type, SegmentType::kArc);
+  EXPECT_DOUBLE_EQ(sc.path[2].radius_m, 2.0);
+  EXPECT_DOUBLE_EQ(sc.path[2].angle_rad, -45.0 * kDeg);
+  EXPECT_DOUBLE_EQ(sc.path[3].radius_m, 0.5 / (30.0 * kDeg));  // speed / yaw rate
+  EXPECT_EQ(sc.path[4].type, SegmentType::kSpin);
+  EXPECT_DOUBLE_EQ(sc.path[4].yaw_rate_rad_s, 45.0 * kDeg);
+  EXPECT_DOUBLE_EQ(sc.path[4].angle_rad, kPi);
+  EXPECT_EQ(sc.path[5].type, SegmentType::kFigureEight);
+  EXPECT_EQ(sc.path[5].laps, 2);
+  EXPECT_TRUE(sc.path[5].right_first);
+  EXPECT_EQ(sc.path[6].type, SegmentType::kStop);
+  EXPECT_DOUBLE_EQ(sc.path[6].duration_s, 1.5);
+  EXPECT_EQ(sc.path[2].line, 16);  // where its `type` is, for later messages
+}
+
+TEST(DriveScenario, RobotSlipDropoutsAndImu) {
+  const DriveScenario sc = load_ok(R"(
+[[path]]
+type = "straight"
+length_m = 20.0
+speed_mps = 1.0
+[robot]
+kinematics = "skid_steer"
+track_width_m = 0.7
+wheel_radius_m = 0.15
+counts_per_rev = 1024
+gear_ratio = 25.0
+encoder_bits = 24
+encoder_signed = true
+heartbeat_period_s = 0.05
+left_nodes = [5, 6]
+right_nodes = [7, 8]
+left_radius_error = [0.01, -0.01]
+right_radius_error = [0.0, 0.02]
+invert_right = true
+[slip]
+noise_fraction = 0.02
+correlation_time_s = 0.25
+[[slip.episode]]
+start_s = 3.0
+duration_s = 1.0
+wheel = "right_rear"
+fraction = 0.5
+[[slip.episode]]
+start_s = 5.0
+duration_s = 1.0
+wheel = "left"
+fraction = -0.2
+[[dropout]]
+node = 7
+start_s = 4.0
+duration_s = 2.0
+[imu]
+model = "mpu9250"
+address = 0x69
+rate_hz = 500.0
+gyro_range_dps = 1000
+accel_range_g = 8
+gyro_noise_density_dps_rthz = 0.01
+accel_noise_density_ug_rthz = 300.0
+gyro_bias_dps = [1.0, 2.0, 3.0]
+accel_bias_mps2 = [0.1, 0.2, 0.3]
+xyz_m = [0.1, 0.2, 0.3]
+rpy_deg = [180.0, 0.0, 90.0]
+temperature_c = 40.0
+)");
+  const RobotBody& r = sc.robot;
+  EXPECT_EQ(r.kinematics, DriveKinematics::kSkidSteer);
+  EXPECT_EQ(r.track_width_m, 0.7);
+  EXPECT_EQ(r.counts_per_rev, 1024.0);
+  EXPECT_EQ(r.gear_ratio, 25.0);
+  EXPECT_EQ(r.encoder_bits, 24);
+  EXPECT_TRUE(r.encoder_signed);
+  EXPECT_TRUE(r.invert_right);
+  EXPECT_FALSE(r.invert_left);
+  EXPECT_EQ(r.heartbeat_period_ns, 50'000'000);
+  ASSERT_EQ(r.wheel_count, 4);
+  // Order: left front, left rear, right front, right rear.
+  const std::uint8_t ids[4] = {5, 6, 7, 8};
+  const bool left[4] = {true, true, false, false};
+  const double errors[4] = {0.01, -0.01, 0.0, 0.02};
+  for (int i = 0; i < 4; ++i) {
+    EXPECT_EQ(r.wheels[i].node_id, ids[i]);
+    EXPECT_EQ(r.wheels[i].left, left[i]);
+    EXPECT_EQ(r.wheels[i].radius_error, errors[i]);
+  }
+  EXPECT_EQ(sc.slip.noise_fraction, 0.02);
+  EXPECT_EQ(sc.slip.correlation_time_s, 0.25);
+  ASSERT_EQ(sc.slip.episode_count, 2);
+  EXPECT_EQ(sc.slip.episodes[0].wheel_mask, 0x08);
+  EXPECT_EQ(sc.slip.episodes[1].wheel_mask, 0x03);
+  EXPECT_EQ(sc.slip.episodes[1].fraction, -0.2);
+  ASSERT_EQ(sc.dropout_count, 1);
+  EXPECT_EQ(sc.dropouts[0].node_id, 7);
+  EXPECT_EQ(sc.dropouts[0].start_s, 4.0);
+  EXPECT_EQ(sc.dropouts[0].duration_s, 2.0);
+  const SimImuConfig& imu = sc.imu;
+  EXPECT_EQ(imu.model, SimImuModel::kMpu9250);
+  EXPECT_EQ(imu.address, 0x69);
+  EXPECT_EQ(imu.rate_hz, 500.0);
+  EXPECT_EQ(imu.gyro_range_dps, 1000);
+  EXPECT_EQ(imu.accel_range_g, 8);
+  EXPECT_DOUBLE_EQ(imu.gyro_noise_density, 0.01 * kDeg);
+  EXPECT_DOUBLE_EQ(imu.accel_noise_density, 300e-6 * 9.80665);
+  EXPECT_DOUBLE_EQ(imu.gyro_bias_rad_s[2], 3.0 * kDeg);
+  EXPECT_EQ(imu.accel_bias_mps2[1], 0.2);
+  EXPECT_EQ(imu.xyz_m[2], 0.3);
+  EXPECT_DOUBLE_EQ(imu.rpy_rad[0], kPi);
+  EXPECT_DOUBLE_EQ(imu.rpy_rad[2], 0.5 * kPi);
+  EXPECT_EQ(imu.temperature_c, 40.0);
+}
+
+TEST(DriveScenario, UnknownKeysAreErrorsWithLineColumnAndSuggestion) {
+  const std::string e = load_error(R"(seed = 1
+[[path]]
+type = "straight"
+lenght_m = 3.0
+speed_mps = 1.0
+[robot]
+left_nodes = [1]
+right_nodes = [2]
+trackwidth_m = 0.5
+[imu]
+colour = "blue"
+)");
+  EXPECT_NE(e.find("t.toml:4:1: path[0].lenght_m: unknown key (did you mean 'length_m'?)"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:9:1: robot.trackwidth_m: unknown key (did you mean 'track_width_m'?)"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:11:1: imu.colour: unknown key"), std::string::npos) << e;
+  // The misspelt length leaves the straight without one: said too.
+  EXPECT_NE(e.find("path[0].length_m: missing: give 'length_m' or 'duration_s'"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, WrongTypesAreErrorsAtTheValue) {
+  const std::string e = load_error(R"(seed = "one"
+[[path]]
+type = "straight"
+length_m = "far"
+speed_mps = 1.0
+[robot]
+left_nodes = [1.5]
+right_nodes = 2
+encoder_signed = 1
+)");
+  EXPECT_NE(e.find("t.toml:1:8: seed: expected integer, got string"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:4:12: path[0].length_m: expected float, got string"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:7:15: robot.left_nodes[0]: expected integer, got float"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:8:15: robot.right_nodes: expected array, got integer"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:9:18: robot.encoder_signed: expected boolean, got integer"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, OutOfRangeValuesAreErrors) {
+  const std::string e = load_error(R"([limits]
+max_accel_mps2 = -1.0
+[[path]]
+type = "arc"
+radius_m = 2.0
+angle_deg = 0.0
+speed_mps = 50.0
+[robot]
+encoder_bits = 40
+left_nodes = [0]
+right_nodes = [2]
+[imu]
+gyro_range_dps = 300
+address = 0x80
+)");
+  EXPECT_NE(e.find("t.toml:2:18: limits.max_accel_mps2: must be > 0 and <= 20 m/s^2, got -1"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:6:13: path[0].angle_deg: must be non-zero"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:7:13: path[0].speed_mps: must be > 0 and <= 20 m/s, got 50"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:9:16: robot.encoder_bits: must be between 8 and 32, got 40"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:10:15: robot.left_nodes[0]: a CANopen node id is 1..127, got 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:13:18: imu.gyro_range_dps: must be 250, 500, 1000 or 2000, got 300"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:14:11: imu.address: must be between 8 and 119, got 128"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, InconsistentEntriesAreErrors) {
+  const std::string e = load_error(R"([[path]]
+type = "straight"
+length_m = 2.0
+duration_s = 2.0
+speed_mps = 1.0
+[[path]]
+type = "hover"
+[robot]
+left_nodes = [1, 3]
+right_nodes = [1]
+[[slip.episode]]
+start_s = 1.0
+duration_s = 1.0
+wheel = "left_front"
+fraction = 0.2
+[[dropout]]
+node = 9
+start_s = 1.0
+duration_s = 1.0
+)");
+  EXPECT_NE(e.find("t.toml:4:1: path[0].duration_s: give either 'length_m' or 'duration_s', not both"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:7:8: path[1].type: must be one of 'straight', 'arc', 'spin', 'figure_eight', 'stop'"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:9:1: robot.left_nodes: expected 1 node id for this kinematics, got 2"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("episode[0].wheel: must be 'left', 'right' or 'all'"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:17:8: dropout[0].node: no wheel of [robot] has node id 9"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, DuplicateNodesAndOverlappingDropoutsAreErrors) {
+  const std::string e = load_error(R"([[path]]
+type = "stop"
+duration_s = 5.0
+[robot]
+left_nodes = [4]
+right_nodes = [4]
+[[dropout]]
+node = 4
+start_s = 1.0
+duration_s = 2.0
+[[dropout]]
+node = 4
+start_s = 2.5
+duration_s = 1.0
+)");
+  EXPECT_NE(e.find("t.toml:6:1: robot.right_nodes: node id 4 is used twice"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:13:1: dropout[1].start_s: overlaps an earlier dropout of node 4"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, ArcTooShortForItsTransitionsIsReportedAtItsEntry) {
+  // At 1 m/s into a 0.5 m radius the clothoid is 2 * 1^2 / (pi/2) = 1.27 m
+  // long and turns 1.27 * 2 / 2 rad = 73 degrees, on each side: more than
+  // the 90 degrees asked.
+  const std::string e = load_error(R"([limits]
+max_yaw_accel_dps2 = 90.0
+[[path]]
+type = "straight"
+length_m = 5.0
+speed_mps = 1.0
+[[path]]
+type = "arc"
+radius_m = 0.5
+angle_deg = 90.0
+speed_mps = 1.0
+[[path]]
+type = "straight"
+length_m = 5.0
+speed_mps = 1.0
+)" + kRobot);
+  EXPECT_NE(e.find("t.toml:8:1: path[1]: its curvature transitions alone turn the robot by 145.9 deg"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("raise [limits] max_yaw_accel_dps2"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, DurationShorterThanThePathIsAnError) {
+  // 10 m at 1 m/s from rest to rest at 0.5 m/s^2: 2 s ramps, 8 m cruise: 12 s.
+  const std::string e = load_error(R"(duration_s = 10.0
+[[path]]
+type = "straight"
+length_m = 10.0
+speed_mps = 1.0
+)" + kRobot);
+  EXPECT_NE(e.find("t.toml:1:14: duration_s: the path takes 12 s with these speeds and limits"), std::string::npos)
+      << e;
+}
+
+TEST(DriveScenario, EmptyPathNeedsADuration) {
+  EXPECT_NE(load_error(kRobot).find("duration_s: the path is empty"), std::string::npos);
+  const DriveScenario sc = load_ok("duration_s = 5.0\n" + kRobot);
+  EXPECT_TRUE(sc.path.empty());
+}
+
+TEST(DriveScenario, SyntaxErrorsAndUnreadableFiles) {
+  const std::string e = load_error("seed = \n");
+  EXPECT_EQ(e.rfind("t.toml:1:", 0), 0u) << e;
+  DriveScenario sc;
+  std::string error;
+  EXPECT_FALSE(load_drive_scenario("/nonexistent/scenario.toml", &sc, &error));
+  EXPECT_EQ(error, "/nonexistent/scenario.toml: cannot read the scenario: No such file or directory");
+}
+
+}  // namespace
+}  // namespace rtfuse::sim
