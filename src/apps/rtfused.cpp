@@ -1,25 +1,36 @@
 // rtfused: the live daemon. Loads the config (the embedded config/sim.toml by
-// default), starts the runtime, and when [sim] is enabled drives the built-in
-// simulated robot onto the same LCM channels a real robot would use.
+// default), opens the buses its drivers need (the kernel's with
+// [hardware] backend = "linux", the bus-level simulated robot with "sim"),
+// starts the runtime, and with --record writes a HAL recording. With the
+// simulated robot it publishes ground truth and reports the error against it.
+// The older LCM-level simulated robot ([sim] enabled, config/sim_lcm.toml)
+// publishes sensor messages on the input channels instead.
 #include <unistd.h>
 
 #include <atomic>
 #include <cmath>
 #include <csignal>
+#include <cerrno>
 #include <cstdio>
+#include <cstring>
 #include <string>
 #include <thread>
 
 #include <CLI/CLI.hpp>
 
+#include "hal/linux/monotonic_clock.hpp"
 #include "runtime/config_loader.hpp"
+#include "runtime/linux_hal.hpp"
 #include "runtime/loop_timer.hpp"
 #include "runtime/realtime.hpp"
 #include "runtime/runtime.hpp"
+#include "sim/ground_truth.hpp"
 #include "sim/sim_robot.hpp"
+#include "sim/simulated_robot.hpp"
 
 namespace rtfuse::apps {
 extern const std::string_view kEmbeddedSimConfig;
+extern const std::string_view kEmbeddedDemoScenario;
 }
 
 // Optional hook for the allocation probe (tests/system/alloc_probe.c, loaded
@@ -43,6 +54,30 @@ void sim_thread(rtfuse::sim::SimRobot* sim, rtfuse::transport::LcmNode* lcm, std
   }
 }
 
+// Ground truth of the bus-level simulated robot onto LCM, at 50 Hz.
+void truth_thread(rtfuse::sim::SimulatedRobot* robot, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
+  rtfuse::name_this_thread("rtfuse-sim");
+  rtfuse::sim::GroundTruthEncoder encoder;
+  rtfuse::TimeNs next = rtfuse::monotonic_now_ns();
+  while (run->load(std::memory_order_relaxed)) {
+    next += 20'000'000;
+    rtfuse::sleep_until(next);
+    int size = 0;
+    const std::uint8_t* bytes = encoder.encode(robot->truth_at(next), next, &size);
+    if (size > 0) lcm->publish(rtfuse::sim::kGroundTruthChannel, bytes, size);
+  }
+}
+
+bool read_text(const std::string& path, std::string* text) {
+  std::FILE* f = std::fopen(path.c_str(), "rb");
+  if (!f) return false;
+  char buf[1 << 14];
+  std::size_t n = 0;
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
+  std::fclose(f);
+  return true;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -61,6 +96,9 @@ int main(int argc, char** argv) {
       });
   app.add_option("--lcm-url", lcm_url, "override [lcm] url");
   app.add_flag("-q,--quiet", quiet, "no live status line");
+  std::string record_path;
+  app.add_option("--record", record_path,
+                 "write every bus event, loop tick and output to this LCM log (replay it with rtfuse-replay)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -68,10 +106,16 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
 
-  rtfuse::ConfigLoadResult loaded =
-      config_path.empty()
-          ? rtfuse::load_config_string(rtfuse::apps::kEmbeddedSimConfig, "<embedded config/sim.toml>")
-          : rtfuse::load_config_file(config_path);
+  std::string config_text(rtfuse::apps::kEmbeddedSimConfig);
+  if (!config_path.empty()) {
+    config_text.clear();
+    if (!read_text(config_path, &config_text)) {
+      std::fprintf(stderr, "rtfused: %s: cannot read: %s\n", config_path.c_str(), std::strerror(errno));
+      return 2;
+    }
+  }
+  rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(
+      config_text, config_path.empty() ? std::string("<embedded config/sim.toml>") : config_path);
   if (!loaded.config) {
     for (const auto& e : loaded.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
     return 2;
@@ -80,7 +124,31 @@ int main(int argc, char** argv) {
   if (!lcm_url.empty()) cfg.lcm_url = lcm_url;
 
   std::string error;
-  auto runtime = rtfuse::Runtime::create(cfg, &error);
+  rtfuse::HalBuses buses;
+  std::unique_ptr<rtfuse::LinuxHal> linux_hal;
+  rtfuse::hal::MonotonicClock clock;
+  std::unique_ptr<rtfuse::sim::SimulatedRobot> robot;
+  if (cfg.hardware.backend == rtfuse::HalBackend::kLinux) {
+    linux_hal = rtfuse::LinuxHal::open(cfg, &error);
+    if (!linux_hal) {
+      std::fprintf(stderr, "rtfused: %s\n", error.c_str());
+      return 1;
+    }
+    buses = linux_hal->buses();
+  } else if (cfg.hardware.backend == rtfuse::HalBackend::kSim) {
+    // The embedded config's scenario is the embedded demo drive.
+    const std::string_view demo = rtfuse::apps::kEmbeddedDemoScenario;
+    const bool embedded = config_path.empty();
+    robot = rtfuse::sim::SimulatedRobot::create(cfg, embedded ? "<embedded config/scenarios/demo.toml>" : "",
+                                                clock, rtfuse::monotonic_now_ns(), &error,
+                                                embedded ? &demo : nullptr);
+    if (!robot) {
+      std::fprintf(stderr, "rtfused: %s\n", error.c_str());
+      return 2;
+    }
+    buses = robot->buses();
+  }
+  auto runtime = rtfuse::Runtime::create(cfg, buses, record_path, config_text, &error);
   if (!runtime) {
     std::fprintf(stderr, "rtfused: %s\n", error.c_str());
     return 1;
@@ -100,12 +168,15 @@ int main(int argc, char** argv) {
     return 3;
   }
   if (!warnings.empty()) std::fprintf(stderr, "rtfused: warning: %s", warnings.c_str());
-  std::fprintf(stderr, "rtfused: %s, loop %.0f Hz, %d sensors, LCM %s%s\n", cfg.source.c_str(), cfg.rate_hz,
-               cfg.num_sensors, cfg.lcm_url.c_str(), sim ? ", simulated robot" : "");
+  std::fprintf(stderr, "rtfused: %s, loop %.0f Hz, %d sensors, LCM %s%s%s%s\n", cfg.source.c_str(), cfg.rate_hz,
+               cfg.num_sensors, cfg.lcm_url.c_str(),
+               sim ? ", LCM-level simulated robot" : "", robot ? ", bus-level simulated robot" : "",
+               record_path.empty() ? "" : (", recording to " + record_path).c_str());
 
   std::atomic<bool> sim_run{true};
   std::thread sim_worker;
   if (sim) sim_worker = std::thread(sim_thread, sim.get(), &runtime->lcm(), &sim_run);
+  if (robot) sim_worker = std::thread(truth_thread, robot.get(), &runtime->lcm(), &sim_run);
 
   const bool tty = isatty(STDERR_FILENO) != 0;
   const rtfuse::TimeNs start = rtfuse::monotonic_now_ns();
@@ -128,9 +199,18 @@ int main(int argc, char** argv) {
     if (now < next_sample) continue;
     next_sample = now + 100'000'000;
     s = runtime->latest();
-    if (sim && s.initialized) {
-      const rtfuse::sim::TruthPose truth = sim->truth(s.stamp_ns);
-      last_error = std::hypot(s.state[0] - truth.x, s.state[1] - truth.y);
+    if ((sim || robot) && s.initialized) {
+      double tx = 0.0, ty = 0.0;
+      if (sim) {
+        const rtfuse::sim::TruthPose truth = sim->truth(s.stamp_ns);
+        tx = truth.x;
+        ty = truth.y;
+      } else {
+        const rtfuse::sim::TruthState truth = robot->truth_at(s.stamp_ns);
+        tx = truth.x;
+        ty = truth.y;
+      }
+      last_error = std::hypot(s.state[0] - tx, s.state[1] - ty);
       err_sq_sum += last_error * last_error;
       ++err_samples;
     }
@@ -151,14 +231,27 @@ int main(int argc, char** argv) {
 
   sim_run.store(false);
   if (sim_worker.joinable()) sim_worker.join();
-  runtime->stop();
+  const bool recorded = runtime->stop(&error);
   s = runtime->latest();
   std::printf("rtfused: ran %.1f s, %lld ticks, %lld overruns, %lld measurements fused\n",
               rtfuse::ns_to_sec(rtfuse::monotonic_now_ns() - start), static_cast<long long>(s.loop.ticks),
               static_cast<long long>(s.loop.overruns), static_cast<long long>(s.loop.measurements_fused));
-  if (sim && err_samples > 0) {
+  for (int i = 0; i < s.num_devices; ++i) {
+    const rtfuse::DeviceStatus& d = s.devices[i];
+    std::printf("rtfused: device %s (%s): %s", d.name.c_str(), d.hardware_id.c_str(), d.state.c_str());
+    for (int k = 0; k < d.num_values && k < 3; ++k) std::printf(", %s %lld", d.keys[k], static_cast<long long>(d.values[k]));
+    std::printf("\n");
+  }
+  if ((sim || robot) && err_samples > 0) {
     std::printf("rtfused: position error against ground truth: final %.3f m, RMS %.3f m over %ld samples\n",
                 last_error, std::sqrt(err_sq_sum / err_samples), err_samples);
+  }
+  if (!record_path.empty()) {
+    if (!recorded) {
+      std::fprintf(stderr, "rtfused: recording %s: %s\n", record_path.c_str(), error.c_str());
+      return 1;
+    }
+    std::printf("rtfused: recorded to %s (replay: rtfuse-replay -l %s)\n", record_path.c_str(), record_path.c_str());
   }
   return 0;
 }

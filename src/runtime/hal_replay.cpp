@@ -1,6 +1,8 @@
 #include "runtime/hal_replay.hpp"
 
+#include <algorithm>
 #include <cstdio>
+#include <iterator>
 #include <map>
 #include <vector>
 
@@ -26,11 +28,19 @@ std::string hex64(std::int64_t v) {
 // recorded ones, channel by channel in publishing order.
 class CompareSink final : public MessageSink {
  public:
-  CompareSink(const transport::HalRecording& rec, const std::string& diagnostics_channel,
-              transport::EventLogWriter* out)
-      : diagnostics_(diagnostics_channel), out_(out) {
+  // Only the estimate channels are compared: other recorded channels (the
+  // simulator's ground truth) are not the publisher's.
+  CompareSink(const transport::HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out)
+      : diagnostics_(cfg.publish.diagnostics_channel.view()), out_(out) {
+    const std::string estimate[] = {std::string(cfg.publish.odometry_channel.view()),
+                                    std::string(cfg.publish.pose_channel.view()),
+                                    std::string(cfg.publish.tf_channel.view()),
+                                    std::string(cfg.publish.state_channel.view()),
+                                    std::string(cfg.hardware.wheel_odometry.raw_channel.view())};
     for (const transport::RecordedOutput& o : rec.outputs) {
-      if (o.channel != diagnostics_) recorded_[o.channel].push_back(&o);
+      if (std::find(std::begin(estimate), std::end(estimate), o.channel) != std::end(estimate)) {
+        recorded_[o.channel].push_back(&o);
+      }
     }
   }
 
@@ -172,7 +182,7 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     core->set_devices(hardware.get());
   }
   Publisher publisher(core->config());
-  CompareSink sink(rec, std::string(cfg.publish.diagnostics_channel.view()), out);
+  CompareSink sink(rec, cfg, out);
 
   auto diverged = [&]() -> const hal::mock::ReplayStream* {
     for (const auto& s : rec.streams) {

@@ -126,7 +126,9 @@ bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& fram
 }
 
 Hardware::Hardware(const RuntimeConfig& cfg, FusionCore& core)
-    : cfg_(cfg), core_(core), slots_(device_slots(cfg)) {}
+    : cfg_(cfg), core_(core), slots_(device_slots(cfg)) {
+  describe_devices(cfg, layout_, kMaxDevices);
+}
 
 std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& core, std::string* error) {
   const RuntimeConfig& cfg = core.config();
@@ -198,9 +200,8 @@ void Hardware::before_drain(TimeNs now) noexcept {
   c(2, 2) = c(3, 3) = c(4, 4) = kUnmeasuredVariance;
   c(5, 5) = tw.var_vyaw;
   c(0, 5) = c(5, 0) = tw.cov_vx_vyaw;
-  // The loop is this ring's only producer; a full ring is counted by the
-  // drain as overflow, as for LCM inputs.
-  core_.input().ring(cfg_.hardware.wheel_sensor).try_push(s);
+  // The loop is this ring's only producer.
+  core_.input().push_from_driver(cfg_.hardware.wheel_sensor, s);
 }
 
 drivers::StepResult Hardware::imu_step(TimeNs edge_timeout_ns) noexcept {
@@ -220,7 +221,7 @@ drivers::StepResult Hardware::imu_step(TimeNs edge_timeout_ns) noexcept {
     i.angular_velocity_covariance = m.angular_velocity_cov;
     i.linear_acceleration = m.linear_acceleration;
     i.linear_acceleration_covariance = m.linear_acceleration_cov;
-    core_.input().ring(cfg_.hardware.mpu_sensor).try_push(s);
+    core_.input().push_from_driver(cfg_.hardware.mpu_sensor, s);
     imu_samples_.fetch_add(1, std::memory_order_acq_rel);
     h.temperature_c = m.temperature_c;
     h.last_sample_ns = m.stamp;
@@ -233,6 +234,10 @@ drivers::StepResult Hardware::imu_step(TimeNs edge_timeout_ns) noexcept {
 
 void Hardware::fill_snapshot(Snapshot& s) noexcept {
   s.num_devices = slots_.count;
+  for (int i = 0; i < slots_.count; ++i) {
+    s.devices[i].name = layout_[i].name;
+    s.devices[i].hardware_id = layout_[i].hardware_id;
+  }
   if (encoders_) fill_can(s);
   if (imu_) fill_imu(s);
 }

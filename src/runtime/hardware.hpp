@@ -68,6 +68,7 @@ class Hardware final : public TickDevices {
   const RuntimeConfig& cfg_;
   FusionCore& core_;
   DeviceSlots slots_;
+  DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
   int base_frame_ = -1;
   std::unique_ptr<drivers::CanopenEncoders> encoders_;
   std::unique_ptr<drivers::WheelOdometry> wheels_;

@@ -38,6 +38,15 @@ class InputRouter {
   SpscRing<est::SensorSample>& ring(int sensor) { return *rings_[sensor]; }
   SpscRing<SetPoseCommand>& set_pose_ring() { return set_pose_ring_; }
   const InputCounters& counters(int sensor) const { return counters_[sensor]; }
+  // For a driver that feeds a sensor's ring itself (its only producer):
+  // counts it as received, or as overflow when the ring is full.
+  bool push_from_driver(int sensor, const est::SensorSample& s) noexcept {
+    InputCounters& c = counters_[sensor];
+    c.received.fetch_add(1, std::memory_order_relaxed);
+    if (rings_[sensor]->try_push(s)) return true;
+    c.overflow.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
   std::int64_t unknown_channel_messages() const { return unknown_.load(std::memory_order_relaxed); }
   std::int64_t set_pose_decode_errors() const { return set_pose_errors_.load(std::memory_order_relaxed); }
   int num_sensors() const { return num_sensors_; }

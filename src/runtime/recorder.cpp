@@ -64,6 +64,13 @@ int Recorder::stream_index(std::string_view name) const {
   return -1;
 }
 
+bool Recorder::backlogged() const noexcept {
+  for (const auto& r : rings_) {
+    if (2 * r->size() > r->capacity()) return true;
+  }
+  return 2 * ticks_.size() > ticks_.capacity() || 2 * outputs_.size() > outputs_.capacity();
+}
+
 bool Recorder::record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n) noexcept {
   if (n < 0 || n > kMaxTickSensors || (n > 0 && consumed == nullptr)) {
     ticks_rejected_.fetch_add(1, std::memory_order_relaxed);

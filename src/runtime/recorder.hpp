@@ -118,6 +118,11 @@ class Recorder {
   // Counters so far; allocates (call from a non-RT thread).
   RecorderStats stats() const;
 
+  // True while some ring is more than half full. A lockstep producer (the
+  // simulator, which runs as fast as the CPU allows) waits on it so the
+  // writer keeps up and nothing is lost; the live loop never waits.
+  bool backlogged() const noexcept;
+
  private:
   using TickSlot = recorder_detail::TickSlot;
   using OutputSlot = recorder_detail::OutputSlot;

@@ -196,8 +196,8 @@ struct SimRobot::Impl {
 
   // What the encoders report through the differential-drive kinematics when
   // each wheel's ground speed is off by its own slip fraction.
-  WheelSlip slip_at(double t, const Kinematics& k) const noexcept {
-    WheelSlip w{};
+  SimRobotSlip slip_at(double t, const Kinematics& k) const noexcept {
+    SimRobotSlip w{};
     w.left = wheel_slip_at(t, 0);
     w.right = wheel_slip_at(t, 1);
     const double v_left = k.v - 0.5 * kTrackWidth * k.yaw_rate;
@@ -265,7 +265,7 @@ void SimRobot::Impl::build_imu(TimeNs stamp) noexcept {
 void SimRobot::Impl::build_odom(TimeNs stamp) noexcept {
   const double t = seconds(stamp);
   const Kinematics k = path.at(t);
-  const WheelSlip slip = slip_at(t, k);
+  const SimRobotSlip slip = slip_at(t, k);
   const double vx = k.v * (1.0 + slip.speed_fraction) + cfg.odom_speed_noise_mps * odom_noise();
   const double vyaw = k.yaw_rate + slip.yaw_rate_error + cfg.odom_yaw_rate_noise_rad_s * odom_noise();
 
@@ -393,7 +393,7 @@ TruthPose SimRobot::truth(TimeNs t) const noexcept {
 
 double SimRobot::period_s() const noexcept { return impl_->path.period(); }
 
-WheelSlip SimRobot::slip(TimeNs t) const noexcept {
+SimRobotSlip SimRobot::slip(TimeNs t) const noexcept {
   const double s = impl_->seconds(t);
   return impl_->slip_at(s, impl_->path.at(s));
 }

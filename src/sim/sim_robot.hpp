@@ -27,7 +27,7 @@ struct TruthPose {
 };
 
 // The wheel odometry's systematic error at one instant, before white noise.
-struct WheelSlip {
+struct SimRobotSlip {
   double left, right;     // each wheel's fractional ground-speed error, |s| <= wheel_slip
   double speed_fraction;  // resulting forward-speed error: vx = v * (1 + speed_fraction)
   double yaw_rate_error;  // resulting yaw-rate error, rad/s (added to the true rate)
@@ -56,7 +56,7 @@ class SimRobot {
   TruthPose truth(TimeNs t) const noexcept;
   // Time to drive the figure eight once.
   double period_s() const noexcept;
-  WheelSlip slip(TimeNs t) const noexcept;
+  SimRobotSlip slip(TimeNs t) const noexcept;
   const SimBiases& biases() const noexcept;
 
  private:

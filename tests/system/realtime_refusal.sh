@@ -24,6 +24,7 @@ run_case() {  # name lock priority require expected-exit expected-message...
   shift 5
   local cfg=$work/$name.toml
   cp "$src/config/sim.toml" "$cfg"
+  [[ -d $work/scenarios ]] || cp -r "$src/config/scenarios" "$work/"  # the config's drive, relative to it
   printf '\n[realtime]\nlock_memory = %s\npriority = %s\nrequire = %s\n' "$lock" "$prio" "$require" >> "$cfg"
   set +e
   (ulimit -r 0; ulimit -l 64; "${drop[@]}" "$rtfused" --config "$cfg" --duration 1 --quiet --lcm-url memq://) \
@@ -53,7 +54,7 @@ pid=$!
 sleep 1.5
 names=$(cat /proc/$pid/task/*/comm | sort | tr '\n' ' ')
 echo "threads: $names"
-for n in rtfuse-loop rtfuse-pub rtfuse-lcmin rtfuse-sim; do
+for n in rtfuse-loop rtfuse-pub rtfuse-lcmin rtfuse-imu rtfuse-sim; do
   [[ " $names " == *" $n "* ]] || { echo "FAIL: no thread named $n"; kill $pid; exit 1; }
 done
 kill -INT $pid

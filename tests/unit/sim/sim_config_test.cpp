@@ -1,4 +1,4 @@
-// config/sim.toml: it loads, it matches the simulated robot it configures,
+// config/sim_lcm.toml (the LCM-level simulated robot): it loads, it matches the simulated robot it configures,
 // and the fusion it asks for does better than the robot's own odometry.
 #include <gtest/gtest.h>
 
@@ -19,7 +19,7 @@ constexpr TimeNs kSec = 1'000'000'000;
 constexpr double kPi = 3.14159265358979323846;
 
 RuntimeConfig load_sim_toml() {
-  const ConfigLoadResult r = load_config_file(RTFUSE_SOURCE_DIR "/config/sim.toml");
+  const ConfigLoadResult r = load_config_file(RTFUSE_SOURCE_DIR "/config/sim_lcm.toml");
   for (const auto& e : r.errors) ADD_FAILURE() << e.to_string();
   return r.ok() ? *r.config : RuntimeConfig{};
 }
@@ -31,7 +31,7 @@ int sensor_index(const RuntimeConfig& cfg, std::string_view name) {
 }
 
 TEST(SimToml, LoadsWithoutErrorsAndMatchesTheSimulatedRobot) {
-  const ConfigLoadResult r = load_config_file(RTFUSE_SOURCE_DIR "/config/sim.toml");
+  const ConfigLoadResult r = load_config_file(RTFUSE_SOURCE_DIR "/config/sim_lcm.toml");
   for (const auto& e : r.errors) ADD_FAILURE() << e.to_string();
   ASSERT_TRUE(r.ok());
   const RuntimeConfig& cfg = *r.config;

@@ -237,7 +237,7 @@ TEST(SimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
     if (c.channel != "wheel/odom") continue;
     const auto odom = decode<rtfuse::odometry_t>(c);
     const TruthPose truth = robot.truth(c.stamp);
-    const WheelSlip s = robot.slip(c.stamp);
+    const SimRobotSlip s = robot.slip(c.stamp);
     slip_min = std::min({slip_min, s.left, s.right, s.speed_fraction});
     slip_max = std::max({slip_max, s.left, s.right, s.speed_fraction});
     yaw_error_max = std::max(yaw_error_max, std::abs(s.yaw_rate_error));

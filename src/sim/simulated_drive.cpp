@@ -1,0 +1,143 @@
+#include "sim/simulated_drive.hpp"
+
+#include <chrono>
+#include <cmath>
+#include <memory>
+#include <thread>
+
+#include "hal/mock/sim_clock.hpp"
+#include "runtime/fusion_core.hpp"
+#include "runtime/hal_replay.hpp"
+#include "runtime/hardware.hpp"
+#include "runtime/publisher.hpp"
+#include "runtime/recording_tap.hpp"
+#include "sim/ground_truth.hpp"
+#include "sim/simulated_robot.hpp"
+
+namespace rtfuse::sim {
+namespace {
+
+class NullSink final : public MessageSink {
+ public:
+  bool publish(const char*, const std::uint8_t*, int, TimeNs) override { return true; }
+};
+
+double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+}  // namespace
+
+DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& options,
+                                const std::function<void(const DriveProgress&)>& progress) {
+  DriveResult result;
+  // Away from 0 so no stamp is ever mistaken for "unset".
+  const TimeNs t0 = 1'000'000'000;
+  hal::mock::SimClock clock(t0);
+  std::string error;
+  std::unique_ptr<SimulatedRobot> robot = SimulatedRobot::create(cfg, options.scenario_path, clock, t0, &error);
+  if (!robot) {
+    result.error = error;
+    return result;
+  }
+  std::unique_ptr<FusionCore> core = FusionCore::create(cfg, &error);
+  if (!core) {
+    result.error = error;
+    return result;
+  }
+  HalBuses buses = robot->buses();
+  std::unique_ptr<RecordingTap> tap;
+  if (!options.record_path.empty()) {
+    tap = RecordingTap::create(options.record_path, core->config(), options.config_text, buses, clock, &error);
+    if (!tap || !tap->recorder().start(&error)) {
+      result.error = error;
+      return result;
+    }
+    buses = tap->buses();
+  }
+  std::unique_ptr<Hardware> hardware = Hardware::create(buses, *core, &error);
+  if (!hardware) {
+    result.error = error;
+    return result;
+  }
+  core->set_devices(hardware.get());
+  Publisher publisher(core->config());
+  NullSink null_sink;
+  std::unique_ptr<runtime::RecordingSink> recording;
+  if (tap) recording = std::make_unique<runtime::RecordingSink>(null_sink, tap->recorder());
+  MessageSink& sink = recording ? static_cast<MessageSink&>(*recording) : null_sink;
+  if (!hardware->start(t0, &error)) {
+    result.error = error;
+    return result;
+  }
+
+  const TimeNs period = static_cast<TimeNs>(std::llround(1e9 / cfg.rate_hz));
+  const TimeNs truth_period = static_cast<TimeNs>(std::llround(1e9 / options.truth_rate_hz));
+  const double duration = robot->duration_s();
+  const TimeNs end = t0 + sec_to_ns(duration);
+  GroundTruthEncoder truth_encoder;
+  TimeNs next_truth = t0;
+  LoopStats loop;
+  loop.rate_hz = cfg.rate_hz;
+  loop.period_ns = period;
+  double sum_sq = 0.0, raw_sum_sq = 0.0;
+  std::int64_t samples = 0, raw_samples = 0;
+  DriveProgress prog;
+  prog.duration_s = duration;
+  for (TimeNs t = t0; t <= end; t += period) {
+    // Let the writer catch up: in lockstep nothing may be lost.
+    while (tap && tap->recorder().backlogged()) std::this_thread::sleep_for(std::chrono::microseconds(200));
+    clock.set(t);
+    // The IMU thread's edges up to this tick, as it would have read them
+    // before the loop woke.
+    if (hardware->has_imu()) {
+      // Bounded: a driver that is down (re-init backing off) does not wait
+      // for edges, and the edge time would not move.
+      for (int k = 0; k < 64 && robot->imu().next_edge_time() <= t; ++k) hardware->imu_step(kImuEdgeTimeoutNs);
+      clock.set(t);
+    }
+    ++loop.ticks;
+    core->tick(t, loop);
+    const Snapshot& snap = core->last_snapshot();
+    if (tap) tap->recorder().record_tick(t, snap.seq, core->consumed(), core->config().num_sensors);
+    publisher.publish(snap, publisher.schedule(snap, t), t, sink);
+    const TruthState truth = robot->truth_at(t);
+    if (t >= next_truth) {
+      next_truth += truth_period;
+      int size = 0;
+      const std::uint8_t* bytes = truth_encoder.encode(truth, t, &size);
+      if (tap && size > 0) tap->recorder().record_output(kGroundTruthChannel, bytes, size, t);
+    }
+    if (snap.initialized) {
+      const double e = std::hypot(snap.state[0] - truth.x, snap.state[1] - truth.y);
+      sum_sq += e * e;
+      ++samples;
+      result.final_error_m = e;
+      result.final_yaw_error_rad = std::abs(wrap(snap.state[5] - truth.yaw));
+    }
+    if (snap.wheel_odometry.valid) {
+      const double e = std::hypot(snap.wheel_odometry.x - truth.x, snap.wheel_odometry.y - truth.y);
+      raw_sum_sq += e * e;
+      ++raw_samples;
+      result.raw_final_error_m = e;
+    }
+    ++result.ticks;
+    if (progress && result.ticks % 2000 == 0) {
+      prog.sim_time_s = ns_to_sec(t - t0);
+      progress(prog);
+    }
+  }
+  result.duration_s = duration;
+  result.rms_error_m = samples > 0 ? std::sqrt(sum_sq / static_cast<double>(samples)) : 0.0;
+  result.raw_rms_error_m = raw_samples > 0 ? std::sqrt(raw_sum_sq / static_cast<double>(raw_samples)) : 0.0;
+  core->snapshot().load(result.final);
+  if (tap) {
+    result.recording_lost = tap->overflows();
+    if (!tap->recorder().stop(&error)) {
+      result.error = "writing the recording: " + error;
+      return result;
+    }
+  }
+  result.ok = true;
+  return result;
+}
+
+}  // namespace rtfuse::sim

@@ -1,0 +1,48 @@
+#pragma once
+// A whole drive of the simulated robot in lockstep on a simulated clock, as
+// fast as the CPU allows: the same Hardware (drivers), FusionCore and
+// Publisher as rtfused, on the simulated buses, optionally recorded as a HAL
+// recording (bus events, ticks, outputs, ground truth) that rtfuse-replay
+// reproduces byte for byte. Used by rtfuse-sim, the drive-scenario tests and
+// the benchmarks.
+#include <cstdint>
+#include <functional>
+#include <string>
+
+#include "runtime/config.hpp"
+#include "runtime/snapshot.hpp"
+
+namespace rtfuse::sim {
+
+struct DriveOptions {
+  std::string scenario_path;  // empty: the config's [hardware] scenario
+  std::string record_path;    // empty: no recording
+  std::string config_text;    // stored in the recording
+  double truth_rate_hz = 50.0;
+};
+
+struct DriveResult {
+  bool ok = false;
+  std::string error;
+  std::int64_t ticks = 0;
+  double duration_s = 0.0;
+  // Position error against ground truth, sampled every tick once the filter
+  // is initialised; and the same for raw wheel odometry (dead reckoning).
+  double final_error_m = 0.0;
+  double rms_error_m = 0.0;
+  double final_yaw_error_rad = 0.0;
+  double raw_final_error_m = 0.0;
+  double raw_rms_error_m = 0.0;
+  Snapshot final;
+  std::int64_t recording_lost = 0;  // events the recorder had no room for (must be 0)
+};
+
+struct DriveProgress {
+  double sim_time_s = 0.0;
+  double duration_s = 0.0;
+};
+
+DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& options,
+                                const std::function<void(const DriveProgress&)>& progress);
+
+}  // namespace rtfuse::sim

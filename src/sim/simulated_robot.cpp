@@ -1,0 +1,79 @@
+#include "sim/simulated_robot.hpp"
+
+#include "sim/ground_truth.hpp"
+#include "transport/encode_buffer.hpp"
+
+namespace rtfuse::sim {
+
+std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg, const std::string& scenario_path,
+                                                       hal::Clock& clock, TimeNs t0, std::string* error,
+                                                       const std::string_view* scenario_text) {
+  std::unique_ptr<SimulatedRobot> r(new SimulatedRobot());
+  const std::string path = scenario_path.empty() ? cfg.hardware.scenario : scenario_path;
+  if (path.empty()) {
+    *error = "no drive scenario: set [hardware] scenario or give --scenario";
+    return nullptr;
+  }
+  const bool loaded = scenario_text != nullptr
+                          ? load_drive_scenario_string(*scenario_text, path, &r->scenario_, error)
+                          : load_drive_scenario(path, &r->scenario_, error);
+  if (!loaded) return nullptr;
+  const RobotBody& body = r->scenario_.robot;
+  const HardwareConfig& hw = cfg.hardware;
+  // The config must address the simulated devices, or the drivers would
+  // talk to nobody and the run would say nothing useful.
+  if (hw.can.enabled) {
+    for (int i = 0; i < hw.can.num_nodes; ++i) {
+      const int id = hw.can.nodes[static_cast<std::size_t>(i)].node_id;
+      bool found = false;
+      for (int w = 0; w < body.wheel_count; ++w) found = found || body.wheels[static_cast<std::size_t>(w)].node_id == id;
+      if (!found) {
+        *error = cfg.source + ": can.node[" + std::to_string(i) + "].node_id = " + std::to_string(id) +
+                 " is not an encoder of the simulated robot in " + path;
+        return nullptr;
+      }
+    }
+  }
+  if (hw.mpu.enabled && hw.mpu.address != r->scenario_.imu.address) {
+    *error = cfg.source + ": mpu.address = " + std::to_string(hw.mpu.address) +
+             " but the simulated IMU in " + path + " answers at " + std::to_string(r->scenario_.imu.address);
+    return nullptr;
+  }
+  r->truth_ = std::make_unique<TruthTrajectory>(r->scenario_);
+  if (!r->truth_->valid()) {
+    *error = path + ": the path cannot be driven within the motion limits";
+    return nullptr;
+  }
+  r->clock_ = &clock;
+  r->t0_ = t0;
+  r->encoders_ = std::make_unique<SimEncoders>(r->scenario_, *r->truth_, clock, t0);
+  r->imu_ = std::make_unique<SimImu>(r->scenario_, *r->truth_, clock, t0);
+  return r;
+}
+
+HalBuses SimulatedRobot::buses() {
+  HalBuses b;
+  b.can = encoders_.get();
+  b.i2c = imu_.get();
+  b.drdy = imu_.get();
+  b.imu_clock = clock_;
+  return b;
+}
+
+double SimulatedRobot::duration_s() const { return truth_->duration_s(); }
+
+TruthState SimulatedRobot::truth_at(TimeNs t) const noexcept { return truth_->truth_at(ns_to_sec(t - t0_)); }
+
+GroundTruthEncoder::GroundTruthEncoder() {
+  fill_ground_truth(TruthState{}, 0, 0, &msg_);
+  buf_.assign(static_cast<std::size_t>(msg_.getEncodedSize() + 64), 0);
+  msg_.encode(buf_.data(), 0, static_cast<int>(buf_.size()));
+}
+
+const std::uint8_t* GroundTruthEncoder::encode(const TruthState& truth, TimeNs stamp, int* size) noexcept {
+  fill_ground_truth(truth, stamp, seq_++, &msg_);
+  *size = transport::encode_into(msg_, buf_.data(), static_cast<int>(buf_.size()));
+  return buf_.data();
+}
+
+}  // namespace rtfuse::sim

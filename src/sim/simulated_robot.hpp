@@ -1,0 +1,67 @@
+#pragma once
+// The bus-level simulated robot as one HalBuses: its encoder nodes on a CAN
+// bus (for the loop thread), its MPU with a data-ready line (for the IMU
+// thread), on a clock that is real (rtfused live) or simulated (rtfuse-sim,
+// tests). Ground truth is a pure function of time, so both sides, and the
+// truth output, agree without sharing state between threads.
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "hal/clock.hpp"
+#include "rtfuse/odometry_t.hpp"
+#include "runtime/config.hpp"
+#include "runtime/hal_buses.hpp"
+#include "sim/drive_scenario.hpp"
+#include "sim/sim_encoders.hpp"
+#include "sim/sim_imu.hpp"
+#include "sim/truth_trajectory.hpp"
+
+namespace rtfuse::sim {
+
+class SimulatedRobot {
+ public:
+  // Loads the scenario named by cfg.hardware.scenario (or `scenario_path`
+  // when given) and checks that the robot configuration can talk to it: the
+  // encoder node ids and the IMU address must be the simulated ones.
+  // scenario_text, when not null, is the scenario itself (a built-in one)
+  // and scenario_path only names it in messages.
+  static std::unique_ptr<SimulatedRobot> create(const RuntimeConfig& cfg, const std::string& scenario_path,
+                                                hal::Clock& clock, TimeNs t0, std::string* error,
+                                                const std::string_view* scenario_text = nullptr);
+
+  HalBuses buses();
+  const DriveScenario& scenario() const { return scenario_; }
+  const TruthTrajectory& truth() const { return *truth_; }
+  SimImu& imu() { return *imu_; }
+  SimEncoders& encoders() { return *encoders_; }
+  TimeNs start_time() const { return t0_; }
+  // The drive's length (scenario duration, or the path's).
+  double duration_s() const;
+  TruthState truth_at(TimeNs t) const noexcept;
+
+ private:
+  SimulatedRobot() = default;
+  DriveScenario scenario_;
+  std::unique_ptr<TruthTrajectory> truth_;
+  std::unique_ptr<SimEncoders> encoders_;
+  std::unique_ptr<SimImu> imu_;
+  hal::Clock* clock_ = nullptr;
+  TimeNs t0_ = 0;
+};
+
+// Encodes ground-truth odometry_t into a buffer sized once: no allocation per message.
+class GroundTruthEncoder {
+ public:
+  GroundTruthEncoder();
+  // Bytes valid until the next call; size in *size.
+  const std::uint8_t* encode(const TruthState& truth, TimeNs stamp, int* size) noexcept;
+
+ private:
+  rtfuse::odometry_t msg_{};
+  std::vector<std::uint8_t> buf_;
+  std::int32_t seq_ = 0;
+};
+
+}  // namespace rtfuse::sim
