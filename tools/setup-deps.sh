@@ -10,7 +10,7 @@ packages=(
   libtomlplusplus-dev libcli11-dev
   libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless
-  python3 python3-rosbag python3-yaml
+  python3 python3-rosbag python3-yaml python3-matplotlib
   iproute2 util-linux
   linux-libc-dev libgpiod-dev
 )
