@@ -10,7 +10,7 @@
 #   jvm_decode     the same recording, then every rtfuse/* event decoded by the
 #                  JVM with the generated classes, as lcm-spy would (plus two
 #                  damaged copies of the log that must be rejected)
-#   zero_alloc     rtfused under LD_PRELOAD=alloc_probe: no heap allocation in
+#   zero_alloc     rtfused --record under LD_PRELOAD=alloc_probe: no heap allocation in
 #                  steady state, in any thread (after the probe's self-test)
 #
 # NAME=VALUE settings (passed by tests/system/CMakeLists.txt):
@@ -177,7 +177,7 @@ case "$mode" in
     say "probe self-test OK"
     rc=0
     RTFUSE_ALLOC_REPORT="$outdir/rtfused.report" LD_PRELOAD="$PROBE" \
-      timeout -k 5 25 "$rtfused" --duration 5 --quiet \
+      timeout -k 5 25 "$rtfused" --duration 5 --quiet --record "$outdir/recording.lcm" \
       >"$outdir/rtfused.stdout" 2>"$outdir/rtfused.stderr" || rc=$?
     show "$outdir/rtfused.stderr" "rtfused stderr"
     show "$outdir/rtfused.stdout" "rtfused stdout"
