@@ -36,9 +36,28 @@ double yaw_of(const Eigen::Quaterniond& q) noexcept {
   return std::atan2(2.0 * (q.w() * q.z() + q.x() * q.y()), 1.0 - 2.0 * (q.y() * q.y() + q.z() * q.z()));
 }
 
+StillnessConfig no_stillness() noexcept {
+  StillnessConfig s;
+  s.enabled = false;
+  return s;
+}
+
+// The estimator judges |a| against the same gravity and sees no gap the
+// filter would not already call one.
+StillnessConfig stillness_for(const AttitudeConfig& c, StillnessConfig s) noexcept {
+  s.gravity = c.gravity;
+  s.max_dt = c.max_dt;
+  return s;
+}
+
 }  // namespace
 
-AttitudeFilter::AttitudeFilter(const AttitudeConfig& config) noexcept : config_(config) { reset(); }
+AttitudeFilter::AttitudeFilter(const AttitudeConfig& config) noexcept : AttitudeFilter(config, no_stillness()) {}
+
+AttitudeFilter::AttitudeFilter(const AttitudeConfig& config, const StillnessConfig& stillness) noexcept
+    : config_(config), still_(stillness_for(config, stillness)) {
+  reset();
+}
 
 void AttitudeFilter::reset() noexcept {
   initialised_ = false;
@@ -51,7 +70,8 @@ void AttitudeFilter::reset() noexcept {
   disturbance_ = 0.0;
   yaw_base_var_ = 0.0;
   yaw_arw_var_ = 0.0;
-  since_init_ = 0.0;
+  yaw_bias_angle_ = 0.0;
+  still_.reset();
 }
 
 void AttitudeFilter::reset(const Eigen::Quaterniond& world_R_base) noexcept {
@@ -77,9 +97,17 @@ double AttitudeFilter::tilt_sigma2() const noexcept {
   return std::max(config_.accel_variance, 0.0) / (g * g);
 }
 
+double AttitudeFilter::bias_sigma() const noexcept {
+  return still_.residual_sigma(config_.gyro_noise_density, std::max(config_.yaw_bias_sigma, 0.0));
+}
+
+double AttitudeFilter::yaw_rate_bias_variance() const noexcept {
+  const double s = bias_sigma();
+  return s * s;
+}
+
 double AttitudeFilter::yaw_variance() const noexcept {
-  const double b = config_.yaw_bias_sigma * since_init_;
-  return yaw_base_var_ + yaw_arw_var_ + b * b;
+  return yaw_base_var_ + yaw_arw_var_ + yaw_bias_angle_ * yaw_bias_angle_;
 }
 
 Eigen::Matrix3d AttitudeFilter::orientation_covariance() const noexcept {
@@ -153,7 +181,7 @@ void AttitudeFilter::propagate_variance(double dt, const Eigen::Vector3d* accel,
     tilt_var_ += arw;
   }
   yaw_arw_var_ += arw;
-  since_init_ += dt;
+  yaw_bias_angle_ += bias_sigma() * dt;
 }
 
 void AttitudeFilter::step_madgwick(const Eigen::Vector3d& gyro, const Eigen::Vector3d* accel_dir, double dt) noexcept {
@@ -217,7 +245,8 @@ AttitudeUpdate AttitudeFilter::update(const Eigen::Vector3d& gyro, const Eigen::
     const double unseen = dt * config_.gap_yaw_rate_sigma;
     yaw_base_var_ += unseen * unseen;
     yaw_arw_var_ += config_.gyro_noise_density * config_.gyro_noise_density * dt;
-    since_init_ += dt;
+    yaw_bias_angle_ += bias_sigma() * dt;
+    still_.interrupt(dt);
     if (has_direction) {
       init_tilt(accel, yaw_of(q_));
     } else {
@@ -235,6 +264,14 @@ AttitudeUpdate AttitudeFilter::update(const Eigen::Vector3d& gyro, const Eigen::
     dir_ptr = &dir;
   } else {
     ++stats_.accel_skipped;
+  }
+  // At standstill the raw gyro is the bias, on every axis: learnt before the
+  // step so this sample's yaw already integrates without it.
+  if (has_direction) {
+    (void)still_.update(gyro, accel, dt, &bias_);
+    clamp_bias();
+  } else {
+    still_.interrupt(dt);
   }
   if (config_.algorithm == AttitudeAlgorithm::kMadgwick) {
     step_madgwick(gyro, dir_ptr, dt);

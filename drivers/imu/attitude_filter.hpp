@@ -7,7 +7,10 @@
 // q = world_R_base, so a level robot at rest has q = identity and measures
 // accel = (0, 0, +g). Yaw starts at 0; nothing observes it, so it drifts with
 // the gyro and its variance only grows. Likewise the gyro-bias component along
-// gravity is not observable from an accelerometer and is not estimated.
+// gravity is not observable from an accelerometer: with a StillnessConfig
+// (the two-argument constructor; MpuImu passes one) it is learnt, with the
+// other axes, while the robot stands still (stillness_bias.hpp); without one
+// it is not estimated.
 //
 // Covariance model (roll/pitch, each; all fixed-size, no allocation):
 //  - both filters pull the tilt toward the accelerometer's with a per-sample
@@ -26,12 +29,17 @@
 //    the filter corrects once |a| is back at g; its square is added to the
 //    variance. An |a|-based detector cannot see a small horizontal
 //    acceleration: below ~sqrt(2 g gravity_tolerance) it goes unreported.
-// Yaw variance = N^2 T (angle random walk) + (yaw_bias_sigma T)^2 (an
-// unestimated bias) + gaps, T the time since initialisation.
+// Yaw variance = N^2 T (angle random walk) + (integral of sigma_b dt)^2 (the
+// bias error, fully correlated over time) + gaps, T the time since
+// initialisation; sigma_b = yaw_bias_sigma until a standstill taught the bias,
+// then what the stillness estimator says is left (its averaging noise plus
+// drift since), never more than yaw_bias_sigma.
 #include <cstdint>
 
 #include <Eigen/Core>
 #include <Eigen/Geometry>
+
+#include "drivers/imu/stillness_bias.hpp"
 
 namespace rtfuse::drivers {
 
@@ -84,7 +92,11 @@ struct AttitudeStats {
 
 class AttitudeFilter {
  public:
+  // Without bias learning at standstill.
   explicit AttitudeFilter(const AttitudeConfig& config = {}) noexcept;
+  // With it (when stillness.enabled); its gravity and max_dt are replaced by
+  // this config's.
+  AttitudeFilter(const AttitudeConfig& config, const StillnessConfig& stillness) noexcept;
 
   // gyro: rad/s as measured (bias not removed); accel: m/s^2 specific force
   // (gravity included), both in base_link; dt: s since the previous sample.
@@ -93,7 +105,7 @@ class AttitudeFilter {
   AttitudeUpdate update(const Eigen::Vector3d& gyro, const Eigen::Vector3d& accel, double dt,
                         bool accel_usable = true) noexcept;
 
-  // Back to uninitialised (bias back to initial_gyro_bias).
+  // Back to uninitialised (bias back to initial_gyro_bias, standstill learning forgotten).
   void reset() noexcept;
   // Initialised at a known orientation, with the single-sample tilt variance.
   void reset(const Eigen::Quaterniond& world_R_base) noexcept;
@@ -108,6 +120,10 @@ class AttitudeFilter {
   const Eigen::Vector3d& angular_velocity() const noexcept { return omega_; }
   double roll_pitch_variance() const noexcept { return tilt_var_ + disturbance_ * disturbance_; }
   double yaw_variance() const noexcept;
+  // Variance of the yaw-rate bias error, (rad/s)^2: yaw_bias_sigma^2 until a
+  // standstill taught the bias, then the stillness estimator's residual.
+  double yaw_rate_bias_variance() const noexcept;
+  const StillnessBiasEstimator& stillness() const noexcept { return still_; }
   // Over roll, pitch, yaw (sensor_msgs/Imu's orientation_covariance).
   Eigen::Matrix3d orientation_covariance() const noexcept;
   const AttitudeStats& stats() const noexcept { return stats_; }
@@ -129,6 +145,7 @@ class AttitudeFilter {
   // Tilt error (rad) from an averaged |a|^2 - g^2 (m^2/s^4).
   double disturbance_from(double excess_sq, double alpha) const noexcept;
   void propagate_variance(double dt, const Eigen::Vector3d* accel, double accel_norm) noexcept;
+  double bias_sigma() const noexcept;
   double tilt_sigma2() const noexcept;
 
   AttitudeConfig config_;
@@ -141,7 +158,8 @@ class AttitudeFilter {
   double disturbance_ = 0.0;   // rad, tilt bias carried from accelerations
   double yaw_base_var_ = 0.0;
   double yaw_arw_var_ = 0.0;
-  double since_init_ = 0.0;  // s
+  double yaw_bias_angle_ = 0.0;  // rad: integral of the yaw-rate bias sigma since initialisation
+  StillnessBiasEstimator still_;
   AttitudeStats stats_;
 };
 

@@ -11,6 +11,16 @@
 // Covariances: angular velocity and linear acceleration from MpuNoise (the
 // datasheet density over the DLPF bandwidth, or configured variances),
 // orientation from the attitude filter's model (attitude_filter.hpp).
+//
+// Gyro bias: the attitude filter estimates roll/pitch's from gravity; with
+// `stillness` enabled all three axes, yaw's included, are learnt while the
+// robot stands still (stillness_bias.hpp) and removed from angular_velocity
+// and from the yaw integration. Once a standstill taught it, the yaw-rate
+// variance (angular_velocity_cov(2,2)) carries what is left of the z bias
+// error (averaging noise plus drift since the last standstill) on top of
+// the noise. Before that it is the noise alone, as sensor_msgs/Imu drivers
+// report it; the unestimated bias is then only in the orientation's yaw
+// variance (AttitudeConfig::yaw_bias_sigma).
 #include <cstdint>
 
 #include <Eigen/Core>
@@ -30,6 +40,7 @@ namespace rtfuse::drivers {
 struct MpuImuConfig {
   MpuConfig chip;
   AttitudeConfig attitude;  // its noise fields are replaced by the `noise` model's
+  StillnessConfig stillness;  // bias learning at standstill; on by default
   MpuNoiseConfig noise;
   // Without a data-ready line: reads per second; <= 0 takes the chip's
   // sample rate. Polling faster than the chip repeats samples (and trips the

@@ -248,4 +248,66 @@ TEST(AttitudeFilterBias, ClampedToMaxBias) {
   EXPECT_NEAR(std::abs(f.gyro_bias().x()), 0.01, 1e-12);
 }
 
+// --- with bias learning at standstill ---------------------------------------
+
+using rtfuse::drivers::StillnessConfig;
+
+// A level robot at rest whose gyro reads (0.005, -0.0035, 0.007): the z part
+// is invisible to gravity, yet learnt while still, and yaw stops drifting.
+TEST_P(AttitudeBoth, StandstillTeachesTheYawBiasAndStopsTheYawDrift) {
+  const Vector3d bias(0.005, -0.0035, 0.007);
+  const Vector3d level(0, 0, kG);
+  AttitudeFilter f(config_for(GetParam()), StillnessConfig{});
+  AttitudeFilter blind(config_for(GetParam()));
+  f.update(bias, level, kDt);
+  blind.update(bias, level, kDt);
+  for (int i = 0; i < 300; ++i) {
+    f.update(bias, level, kDt);
+    blind.update(bias, level, kDt);
+  }
+  EXPECT_TRUE(f.stillness().still());
+  EXPECT_NEAR(f.gyro_bias().z(), 0.007, 1e-5);
+  EXPECT_NEAR(f.gyro_bias().x(), 0.005, 2e-4);
+  EXPECT_NEAR(f.gyro_bias().y(), -0.0035, 2e-4);
+  EXPECT_NEAR(blind.gyro_bias().z(), 0.0, 1e-4);
+  const double yaw = rpy_of(f.orientation()).yaw;
+  EXPECT_LT(std::abs(yaw), 0.007 * 1.0);  // drifted only until learnt
+  for (int i = 0; i < 1000; ++i) {
+    f.update(bias, level, kDt);
+    blind.update(bias, level, kDt);
+  }
+  EXPECT_NEAR(rpy_of(f.orientation()).yaw, yaw, 1e-4);     // 10 s more: still
+  EXPECT_NEAR(rpy_of(blind.orientation()).yaw, 0.091, 2e-3);  // 0.007 rad/s for 13 s
+  EXPECT_NEAR(f.angular_velocity().z(), 0.0, 1e-5);
+  // The bias term of the yaw variance stopped growing at yaw_bias_sigma once
+  // learnt: under 1 s of it, against 13 s for the blind filter.
+  const double s = f.config().yaw_bias_sigma;
+  EXPECT_LT(f.yaw_variance(), s * s * 1.0);
+  EXPECT_GT(blind.yaw_variance(), s * s * 13.0 * 13.0 * 0.99);
+  EXPECT_LT(f.yaw_rate_bias_variance(), 1e-8);
+  EXPECT_EQ(blind.yaw_rate_bias_variance(), s * s);
+}
+
+TEST(AttitudeStillness, GapsAndSaturatedAccelerometersRestartTheWindow) {
+  const Vector3d bias(0, 0, 0.007);
+  const Vector3d level(0, 0, kG);
+  AttitudeFilter f(AttitudeConfig{}, StillnessConfig{});
+  f.update(bias, level, kDt);
+  for (int i = 0; i < 45; ++i) f.update(bias, level, kDt);
+  EXPECT_EQ(f.update(bias, level, 0.5), AttitudeUpdate::kGapReinitialised);
+  for (int i = 0; i < 45; ++i) f.update(bias, level, kDt);
+  EXPECT_EQ(f.update(bias, level, kDt, false), AttitudeUpdate::kUpdated);  // saturated
+  for (int i = 0; i < 45; ++i) f.update(bias, level, kDt);
+  EXPECT_FALSE(f.stillness().still());
+  EXPECT_EQ(f.gyro_bias().z(), 0.0);
+  EXPECT_EQ(f.stillness().stats().restarts, 2);
+  for (int i = 0; i < 100; ++i) f.update(bias, level, kDt);
+  EXPECT_TRUE(f.stillness().still());
+  EXPECT_NEAR(f.gyro_bias().z(), 0.007, 1e-9);
+  // reset() forgets what was learnt.
+  f.reset();
+  EXPECT_EQ(f.gyro_bias().z(), 0.0);
+  EXPECT_FALSE(f.stillness().learnt());
+}
+
 }  // namespace

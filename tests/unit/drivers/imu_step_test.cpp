@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <random>
 
 #include "drivers/imu/mpu_imu.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
@@ -259,6 +260,144 @@ TEST(MpuImuStep, StepDoesNotAllocateOutsideReinit) {
   EXPECT_EQ(stats.out_of_order_edges, 1);
   EXPECT_EQ(stats.nacks, 1);
   EXPECT_EQ(stats.reinits, 0);
+}
+
+// --- gyro bias learnt at standstill ------------------------------------------
+
+// Yaw rate (rad/s), forward speed (m/s) and forward acceleration of a level
+// robot: still 3 s, 1 s speeding up into a 0.3 rad/s turn held 20 s, 0.5 s
+// easing to a 0.05 rad/s turn held 20 s, 1 s stopping, still 2 s.
+struct Motion {
+  double yaw_rate, speed, accel;
+};
+constexpr double kDriveEnd = 47.5;
+Motion drive_at(double t) {
+  if (t < 3.0) return {0.0, 0.0, 0.0};
+  if (t < 4.0) return {0.3 * (t - 3.0), 0.5 * (t - 3.0), 0.5};
+  if (t < 24.0) return {0.3, 0.5, 0.0};
+  if (t < 24.5) return {0.3 - 0.5 * (t - 24.0), 0.5, 0.0};
+  if (t < 44.5) return {0.05, 0.5, 0.0};
+  if (t < 45.5) return {0.05 * (45.5 - t), 0.5 * (45.5 - t), -0.5};
+  return {0.0, 0.0, 0.0};
+}
+
+struct DriveResult {
+  double bias_z_after_first_stop = 0.0;
+  double bias_sigma_after_first_stop = 0.0;
+  double worst_bias_z_in_slow_turn = 0.0;  // farthest from the true 0.007
+  double mean_rate_error_fast = 0.0;       // angular_velocity.z - true, averaged
+  double mean_rate_error_slow = 0.0;
+  double bias_z_end = 0.0;
+  double bias_sigma_end_of_turn = 0.0;     // sqrt of the reported z-rate bias variance
+  double rate_var_end_of_turn = 0.0;       // angular_velocity_cov(2,2)
+  double rate_var_end = 0.0;
+  double heading_error_end = 0.0;          // filter yaw - true yaw, wrapped
+  std::int64_t still_periods_first_stop = 0;
+  std::int64_t still_periods_end_of_turn = 0;
+  std::int64_t still_periods_end = 0;
+  std::int64_t samples = 0;
+  std::size_t allocations = 0;
+};
+
+constexpr double kGyroBiasX = 0.005, kGyroBiasY = -0.0035, kGyroBiasZ = 0.007;
+constexpr double kGyroNoise = 0.003;   // rad/s per sample at 200 Hz: 5x an MPU-6050's at DLPF 3
+constexpr double kAccelNoise = 0.03;   // m/s^2
+
+MpuImuConfig drive_config(bool stillness) {
+  MpuImuConfig c;
+  c.chip.sample_rate_div = 4;  // 200 Hz
+  c.noise.gyro_variance = kGyroNoise * kGyroNoise;
+  c.noise.gyro_noise_density = kGyroNoise / std::sqrt(100.0);  // white up to 100 Hz
+  c.noise.accel_variance = kAccelNoise * kAccelNoise;
+  c.stillness.enabled = stillness;
+  return c;
+}
+
+DriveResult drive(bool stillness) {
+  constexpr TimeNs kStep = 5 * kMs;
+  constexpr double kDtS = 0.005;
+  ImuRig rig(drive_config(stillness));
+  std::mt19937 rng(11);
+  std::normal_distribution<double> gn(0.0, kGyroNoise), an(0.0, kAccelNoise);
+  DriveResult r;
+  double true_yaw = 0.0, fast_sum = 0.0, slow_sum = 0.0;
+  int fast_n = 0, slow_n = 0, k = 0;
+  bool ok = true;
+  rtfuse::test::AllocScope scope;
+  for (double t = 0.0; t <= kDriveEnd + 1e-9; t = (++k) * kDtS) {
+    const Motion m = drive_at(t);
+    const Vector3d gyro(kGyroBiasX + gn(rng), kGyroBiasY + gn(rng), m.yaw_rate + kGyroBiasZ + gn(rng));
+    const Vector3d accel(m.accel + an(rng), m.speed * m.yaw_rate + an(rng), kG + an(rng));
+    rig.t += kStep;
+    ok = ok && rig.sample_at(rig.t, accel, gyro) == StepResult::kSample;
+    if (k > 0) true_yaw += m.yaw_rate * kDtS;  // the first sample only sets the attitude
+    const double bias_z = rig.imu.filter().gyro_bias().z();
+    const double rate_error = rig.m.angular_velocity.z() - m.yaw_rate;
+    if (k == 600) {  // t = 3 s, the end of the first stillness
+      r.bias_z_after_first_stop = bias_z;
+      r.bias_sigma_after_first_stop = std::sqrt(rig.imu.filter().yaw_rate_bias_variance());
+      r.still_periods_first_stop = rig.imu.filter().stillness().stats().still_periods;
+    }
+    if (t >= 4.0 && t < 24.0) {
+      fast_sum += rate_error;
+      ++fast_n;
+    }
+    if (t >= 24.5 && t < 44.5) {
+      slow_sum += rate_error;
+      ++slow_n;
+      r.worst_bias_z_in_slow_turn = std::max(r.worst_bias_z_in_slow_turn, std::abs(bias_z - kGyroBiasZ));
+      r.bias_sigma_end_of_turn = std::sqrt(rig.imu.filter().yaw_rate_bias_variance());
+      r.rate_var_end_of_turn = rig.m.angular_velocity_cov(2, 2);
+      r.still_periods_end_of_turn = rig.imu.filter().stillness().stats().still_periods;
+    }
+  }
+  r.allocations = scope.count();
+  EXPECT_TRUE(ok);
+  r.mean_rate_error_fast = fast_sum / fast_n;
+  r.mean_rate_error_slow = slow_sum / slow_n;
+  r.bias_z_end = rig.imu.filter().gyro_bias().z();
+  r.rate_var_end = rig.m.angular_velocity_cov(2, 2);
+  r.heading_error_end = std::remainder(yaw_of(rig.m.orientation) - true_yaw, 2.0 * 3.14159265358979323846);
+  r.still_periods_end = rig.imu.filter().stillness().stats().still_periods;
+  r.samples = rig.imu.stats().samples;
+  return r;
+}
+
+TEST(MpuImuStillness, ZBiasLearntAtStandstillIsRemovedAndSurvivesSlowTurns) {
+  const DriveResult r = drive(true);
+  EXPECT_EQ(r.samples, 9501);
+  EXPECT_EQ(r.allocations, 0U);
+  EXPECT_NEAR(r.bias_z_after_first_stop, kGyroBiasZ, 5e-4);
+  // The reported uncertainty covers the error actually left (3 sigma).
+  EXPECT_LE(std::abs(r.bias_z_after_first_stop - kGyroBiasZ), 3.0 * r.bias_sigma_after_first_stop);
+  // 0.05 rad/s at 0.5 m/s is constant and |a| ~ g, but above max_rate: not learnt.
+  EXPECT_EQ(r.still_periods_first_stop, 1);
+  EXPECT_EQ(r.still_periods_end_of_turn, 1);
+  EXPECT_LT(r.worst_bias_z_in_slow_turn, 1e-3);
+  EXPECT_NEAR(r.mean_rate_error_fast, 0.0, 2e-3);
+  EXPECT_NEAR(r.mean_rate_error_slow, 0.0, 2e-3);
+  // Without learning the heading would be 0.007 rad/s x 44.5 s = 0.31 rad off.
+  EXPECT_LT(std::abs(r.heading_error_end), 0.03);
+  // The final stop is still too, and keeps the estimate.
+  EXPECT_EQ(r.still_periods_end, 2);
+  EXPECT_NEAR(r.bias_z_end, kGyroBiasZ, 5e-4);
+  // z-rate variance = noise + the bias residual, which grew with the 41 s
+  // since the first stop (2e-5 rad/s per s of drift) and shrank at the second.
+  const double noise = kGyroNoise * kGyroNoise;
+  EXPECT_NEAR(r.rate_var_end_of_turn, noise + r.bias_sigma_end_of_turn * r.bias_sigma_end_of_turn, 1e-15);
+  EXPECT_GT(r.bias_sigma_end_of_turn, 2e-5 * 40.0);
+  EXPECT_GT(r.bias_sigma_end_of_turn, r.bias_sigma_after_first_stop);
+  EXPECT_GT(r.rate_var_end, noise);
+  EXPECT_LT(r.rate_var_end, r.rate_var_end_of_turn);
+}
+
+TEST(MpuImuStillness, DisabledTheZBiasStaysInTheRate) {
+  const DriveResult r = drive(false);
+  // Only Mahony's cross-coupling while accelerating moves it a little.
+  EXPECT_LT(std::abs(r.bias_z_end), 5e-4);
+  EXPECT_NEAR(r.mean_rate_error_fast, kGyroBiasZ, 5e-4);
+  EXPECT_GT(std::abs(r.heading_error_end), 0.25);
+  EXPECT_EQ(r.rate_var_end, kGyroNoise * kGyroNoise);  // noise alone, as before
 }
 
 }  // namespace
