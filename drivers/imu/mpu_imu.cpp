@@ -184,9 +184,10 @@ StepResult MpuImu::deliver(const ImuReading& r, ImuMeasurement* out) noexcept {
   out->has_orientation = filter_.initialised() && !rejected && !r.gyro_saturated;
   out->angular_velocity = r.gyro - filter_.gyro_bias();
   out->angular_velocity_cov = gyro_cov_;
-  // The z bias learnt at standstill is known only so well; the bias is in
-  // base_link, so its error adds to base z. See the header for before.
-  if (filter_.stillness().learnt()) out->angular_velocity_cov(2, 2) += filter_.yaw_rate_bias_variance();
+  // The z bias is known only as well as the last standstill taught it, and
+  // before any standstill only to the chip's start-up tolerance: nothing
+  // else observes it, so its variance belongs in the reported yaw rate.
+  out->angular_velocity_cov(2, 2) += filter_.yaw_rate_bias_variance();
   out->has_angular_velocity = !r.gyro_saturated;
   out->linear_acceleration = r.accel;
   out->linear_acceleration_cov = accel_cov_;
