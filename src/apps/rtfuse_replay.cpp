@@ -116,6 +116,13 @@ int replay_recording(const std::string& log_path, const std::string& config_path
     return 1;
   }
   if (!r.note.empty()) std::fprintf(stderr, "rtfuse-replay: %s\n", r.note.c_str());
+  if (r.ok && r.ended_early && !allow_truncated) {
+    std::fprintf(stderr,
+                 "rtfuse-replay: the recording is incomplete (%" PRId64 " recorded outputs not reproduced); "
+                 "--allow-truncated accepts the part that is there\n",
+                 r.recorded_not_reproduced);
+    return 1;
+  }
   if (!r.ok) {
     std::fprintf(stderr, "rtfuse-replay: %s\n", r.error.c_str());
     return r.diverged ? 3 : 1;

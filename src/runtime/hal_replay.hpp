@@ -26,7 +26,7 @@ namespace rtfuse {
 constexpr TimeNs kImuEdgeTimeoutNs = 50'000'000;
 
 struct HalReplayResult {
-  bool ok = false;            // ran to the end of the recorded ticks, no divergence
+  bool ok = false;            // no set-up error and no divergence (ended_early: stopped before the last tick)
   std::string error;          // set up failed, or the divergence report
   bool diverged = false;
   bool ended_early = false;   // a stream ran out before the last tick (truncated, lost events)
