@@ -14,7 +14,10 @@
   divergence        a recording whose NMT start frame was altered stops the
                     replay with a report naming the event;
   bad_recordings    another config, a truncated file, a plain log without a
-                    config: each a clear message, never a crash.
+                    config: each a clear message, never a crash;
+  linux_backend     rtfused on the real buses of config/robot_linux.toml on
+                    this machine (no CAN, no I2C): exit 1 naming the device,
+                    the errno text and the fix.
 """
 import json
 import os
@@ -235,6 +238,38 @@ def check_bad_recordings(tmp):
     p = replay(plain)
     if p.returncode != 2 or "--config" not in p.stderr:
         sys.exit(f"FAIL: a plain log without --config: exit {p.returncode}\n{p.stderr}")
+
+
+IMU_ONLY_LINUX = """
+[hardware]
+backend = "linux"
+[mpu]
+device = "/dev/i2c-7"
+[[static_transform]]
+parent = "base_link"
+child = "imu_link"
+translation = [0.0, 0.0, 0.0]
+rpy = [0.0, 0.0, 0.0]
+[[sensor]]
+name = "imu"
+type = "imu"
+source = "mpu"
+config = [false, false, false, false, false, false, false, false, false, false, false, true, false, false, false]
+"""
+
+
+def check_linux_backend(tmp):
+    cases = [(os.path.join(SRC, "config", "robot_linux.toml"),
+              ["CAN interface 'can0'", "Address family not supported by protocol", "modprobe can can_raw"])]
+    imu_only = os.path.join(tmp, "imu_only.toml")
+    with open(imu_only, "w") as f:
+        f.write(IMU_ONLY_LINUX)
+    cases.append((imu_only, ["/dev/i2c-7", "No such file or directory", "modprobe i2c-dev"]))
+    for cfg, expected in cases:
+        p = run([RTFUSED, "--config", cfg, "--duration", "1", "--quiet", "--lcm-url", "memq://"])
+        print(p.stderr.strip())
+        if p.returncode != 1 or not all(e in p.stderr for e in expected):
+            sys.exit(f"FAIL: {cfg}: exit {p.returncode}, expected 1 and {expected}")
 
 
 def main():
