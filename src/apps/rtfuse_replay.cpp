@@ -10,6 +10,7 @@
 
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -52,15 +53,6 @@ bool is_hal_recording(const std::string& path) {
          ev.channel == rtfuse::transport::kRecordingInfoChannel;
 }
 
-bool read_text(const std::string& path, std::string* text) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
-  std::fclose(f);
-  return true;
-}
 
 int replay_recording(const std::string& log_path, const std::string& config_path, const std::string& out_path,
                      bool allow_truncated, bool tty) {
@@ -83,8 +75,9 @@ int replay_recording(const std::string& log_path, const std::string& config_path
   std::string source = rec.info.config_path;
   if (!config_path.empty()) {
     std::string given;
-    if (!read_text(config_path, &given)) {
-      std::fprintf(stderr, "rtfuse-replay: cannot read %s\n", config_path.c_str());
+    int err = 0;
+    if (!rtfuse::read_text_file(config_path, &given, &err)) {
+      std::fprintf(stderr, "rtfuse-replay: cannot read %s: %s\n", config_path.c_str(), std::strerror(err));
       return 2;
     }
     const std::string mismatch = rtfuse::check_recording_config(rec.info, given, config_path);

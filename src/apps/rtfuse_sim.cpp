@@ -9,6 +9,7 @@
 
 #include <cinttypes>
 #include <cstdio>
+#include <cstring>
 #include <string>
 
 #include <CLI/CLI.hpp>
@@ -18,15 +19,6 @@
 
 namespace {
 
-bool read_text(const std::string& path, std::string* text) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
-  std::fclose(f);
-  return true;
-}
 
 }  // namespace
 
@@ -44,8 +36,9 @@ int main(int argc, char** argv) {
     return app.exit(e) == 0 ? 0 : 2;
   }
   std::string text;
-  if (!read_text(config_path, &text)) {
-    std::fprintf(stderr, "rtfuse-sim: cannot read %s\n", config_path.c_str());
+  int err = 0;
+  if (!rtfuse::read_text_file(config_path, &text, &err)) {
+    std::fprintf(stderr, "rtfuse-sim: cannot read %s: %s\n", config_path.c_str(), std::strerror(err));
     return 2;
   }
   const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(text, config_path);

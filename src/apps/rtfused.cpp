@@ -68,15 +68,6 @@ void truth_thread(rtfuse::sim::SimulatedRobot* robot, rtfuse::transport::LcmNode
   }
 }
 
-bool read_text(const std::string& path, std::string* text) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return false;
-  char buf[1 << 14];
-  std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
-  std::fclose(f);
-  return true;
-}
 
 }  // namespace
 
@@ -109,8 +100,9 @@ int main(int argc, char** argv) {
   std::string config_text(rtfuse::apps::kEmbeddedSimConfig);
   if (!config_path.empty()) {
     config_text.clear();
-    if (!read_text(config_path, &config_text)) {
-      std::fprintf(stderr, "rtfused: %s: cannot read: %s\n", config_path.c_str(), std::strerror(errno));
+    int err = 0;
+    if (!rtfuse::read_text_file(config_path, &config_text, &err)) {
+      std::fprintf(stderr, "rtfused: %s: cannot read: %s\n", config_path.c_str(), std::strerror(err));
       return 2;
     }
   }

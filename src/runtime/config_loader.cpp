@@ -452,17 +452,25 @@ ConfigLoadResult load_config_string(std::string_view toml_text, const std::strin
   return result;
 }
 
-ConfigLoadResult load_config_file(const std::string& path) {
+bool read_text_file(const std::string& path, std::string* text, int* err) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (!f) return unreadable(path, errno);
-  std::string text;
+  if (!f) {
+    *err = errno;
+    return false;
+  }
   char buf[1 << 14];
   std::size_t n = 0;
-  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text.append(buf, n);
+  while ((n = std::fread(buf, 1, sizeof buf, f)) > 0) text->append(buf, n);
   // A directory opens fine on Linux and fails here with EISDIR.
-  const int err = std::ferror(f) ? (errno != 0 ? errno : EIO) : 0;
+  *err = std::ferror(f) ? (errno != 0 ? errno : EIO) : 0;
   std::fclose(f);
-  if (err != 0) return unreadable(path, err);
+  return *err == 0;
+}
+
+ConfigLoadResult load_config_file(const std::string& path) {
+  std::string text;
+  int err = 0;
+  if (!read_text_file(path, &text, &err)) return unreadable(path, err);
   return load_config_string(text, path);
 }
 

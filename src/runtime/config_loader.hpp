@@ -33,6 +33,9 @@ struct ConfigLoadResult {
 };
 
 ConfigLoadResult load_config_file(const std::string& path);
+// The whole file as text (a config to keep in a recording); false with the
+// errno in *err.
+bool read_text_file(const std::string& path, std::string* text, int* err);
 // source_name stands in for the file name in errors and RuntimeConfig::source.
 ConfigLoadResult load_config_string(std::string_view toml_text, const std::string& source_name);
 

@@ -228,6 +228,15 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
       while (hardware->imu_samples() < target && !s.diverged() && !s.at_end()) {
         hardware->imu_step(kImuEdgeTimeoutNs);
       }
+      // Ticking on without the samples the live loop had would publish
+      // something it never published: the recording ends here.
+      if (hardware->imu_samples() < target && !s.diverged()) {
+        result.ended_early = true;
+        result.note = "the recording of stream '" + s.name() + "' ends before tick " + std::to_string(t.seq) +
+                      ": it holds " + std::to_string(hardware->imu_samples()) + " of the " +
+                      std::to_string(target) + " IMU samples the loop had taken by then";
+        break;
+      }
     }
     if (const auto* s = diverged()) {
       stop_diverged(*s);
@@ -235,13 +244,15 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     }
     ++loop_stats.ticks;
     core->tick(t.time_ns, loop_stats);
-    const Snapshot& snap = core->last_snapshot();
-    publisher.publish(snap, publisher.schedule(snap, t.time_ns), t.time_ns, sink);
-    ++result.ticks;
+    // A tick whose bus calls ran past the recording (or off it) did not
+    // happen as recorded: stop before publishing it.
     if (const auto* s = diverged()) {
       stop_diverged(*s);
       break;
     }
+    const Snapshot& snap = core->last_snapshot();
+    publisher.publish(snap, publisher.schedule(snap, t.time_ns), t.time_ns, sink);
+    ++result.ticks;
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);
   }
