@@ -202,7 +202,7 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     }
   };
 
-  const TimeNs t0 = rec.ticks.empty() ? 0 : rec.ticks.front().time_ns;
+  const TimeNs t0 = rec.info.start_ns != 0 ? rec.info.start_ns : (rec.ticks.empty() ? 0 : rec.ticks.front().time_ns);
   if (hardware && !hardware->start(t0, &err)) {
     if (const auto* s = diverged()) {
       stop_diverged(*s);
@@ -250,8 +250,8 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
       stop_diverged(*s);
       break;
     }
-    const Snapshot& snap = core->last_snapshot();
-    publisher.publish(snap, publisher.schedule(snap, t.time_ns), t.time_ns, sink);
+    // The outputs the live loop queued at this tick, no more, no fewer.
+    publisher.publish(core->last_snapshot(), t.published, t.time_ns, sink);
     ++result.ticks;
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);

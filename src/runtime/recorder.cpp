@@ -71,7 +71,8 @@ bool Recorder::backlogged() const noexcept {
   return 2 * ticks_.size() > ticks_.capacity() || 2 * outputs_.size() > outputs_.capacity();
 }
 
-bool Recorder::record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n) noexcept {
+bool Recorder::record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n,
+                           std::uint32_t published) noexcept {
   if (n < 0 || n > kMaxTickSensors || (n > 0 && consumed == nullptr)) {
     ticks_rejected_.fetch_add(1, std::memory_order_relaxed);
     return false;
@@ -79,6 +80,7 @@ bool Recorder::record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* cons
   tick_staging_.time_ns = t;
   tick_staging_.seq = static_cast<std::int64_t>(seq);
   tick_staging_.n = n;
+  tick_staging_.published = published;
   for (int i = 0; i < n; ++i) tick_staging_.consumed[i] = consumed[i];
   if (!ticks_.try_push(tick_staging_)) {
     ticks_lost_.fetch_add(1, std::memory_order_relaxed);
@@ -205,7 +207,8 @@ std::size_t Recorder::drain_once() noexcept {
     if (tick == nullptr) break;
     int n = -1;
     try {
-      n = codec_.encode_tick(tick->time_ns, tick->seq, tick->consumed, tick->n, buf, static_cast<int>(sizeof buf));
+      n = codec_.encode_tick(tick->time_ns, tick->seq, tick->consumed, tick->n, tick->published, buf,
+                             static_cast<int>(sizeof buf));
     } catch (const std::exception&) {
       n = -1;
     }

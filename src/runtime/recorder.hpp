@@ -67,6 +67,7 @@ struct TickSlot {
   std::int64_t seq = 0;
   std::int32_t n = 0;
   std::int64_t consumed[kMaxTickSensors] = {};
+  std::uint32_t published = 0;
 };
 struct OutputSlot {
   TimeNs now = 0;
@@ -103,7 +104,9 @@ class Recorder {
   // Loop thread only. consumed[i]: samples taken from sensor i's ring since
   // start, up to and including this tick. False: not recorded (ring full, or
   // n outside 0..kMaxTickSensors), counted.
-  bool record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n) noexcept;
+  // published: the outputs the loop queued for this tick (Publisher::OutputBit).
+  bool record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n,
+                   std::uint32_t published = 0) noexcept;
   // Publisher thread only. The bytes are copied. False: not recorded (ring
   // full, too large, channel empty or longer than kMaxChannelLength), counted.
   bool record_output(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept;

@@ -24,10 +24,11 @@ RecordingTap::~RecordingTap() = default;
 
 std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, const RuntimeConfig& cfg,
                                                    const std::string& config_text, const HalBuses& inner,
-                                                   hal::Clock& clock, std::string* error) {
+                                                   hal::Clock& clock, TimeNs start_ns, std::string* error) {
   std::unique_ptr<RecordingTap> t(new RecordingTap());
   transport::RecordingInfo info;
   info.rtfuse_version = "rtfuse " RTFUSE_VERSION;
+  info.start_ns = start_ns;
   info.config_path = cfg.source;
   info.config_text = config_text;
   info.config_hash = transport::config_text_hash(config_text);

@@ -25,9 +25,11 @@ class RecordingTap {
  public:
   // config_text: the TOML the configuration came from, stored in the
   // recording so a replay needs nothing else. clock stamps the bus events.
+  // start_ns: the time the devices are started with (Hardware::start), kept
+  // in the recording so a replay starts them at the same time.
   static std::unique_ptr<RecordingTap> create(const std::string& path, const RuntimeConfig& cfg,
                                               const std::string& config_text, const HalBuses& inner,
-                                              hal::Clock& clock, std::string* error);
+                                              hal::Clock& clock, TimeNs start_ns, std::string* error);
   ~RecordingTap();
   HalBuses buses() const { return buses_; }
   runtime::Recorder& recorder() { return *recorder_; }

@@ -25,7 +25,8 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
   if (!rt->core_) return nullptr;
   HalBuses buses = buses_in;
   if (!record_path.empty()) {
-    rt->tap_ = RecordingTap::create(record_path, rt->core_->config(), config_text, buses, rt->clock_, error);
+    rt->tap_ = RecordingTap::create(record_path, rt->core_->config(), config_text, buses, rt->clock_,
+                                    monotonic_now_ns(), error);
     if (!rt->tap_) return nullptr;
     buses = rt->tap_->buses();
   }
@@ -37,6 +38,9 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
   rt->publisher_ = std::make_unique<Publisher>(rt->core_->config());
   rt->lcm_ = transport::LcmNode::create(cfg.lcm_url, error);
   if (!rt->lcm_) return nullptr;
+  // The publisher thread's sinks, built here: its loop allocates nothing.
+  rt->lcm_sink_ = std::make_unique<LcmSink>(*rt->lcm_);
+  if (rt->tap_) rt->recording_sink_ = std::make_unique<runtime::RecordingSink>(*rt->lcm_sink_, rt->tap_->recorder());
   const RuntimeConfig& c = rt->core_->config();
   for (int i = 0; i < c.num_sensors; ++i) {
     if (c.sensors[i].source != SensorSource::kLcm) continue;
@@ -71,7 +75,10 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   // Devices answer before anything runs: a missing chip or a bus that
   // refuses the NMT start stops here with the device named.
   if (tap_ && !tap_->recorder().start(error)) return false;
-  if (hardware_ && !hardware_->start(monotonic_now_ns(), error)) return false;
+  // A recording holds the start time it was created with, so its replay
+  // starts the devices at the same time (boot-up and NMT timing depend on it).
+  const TimeNs start = tap_ ? tap_->recorder().info().start_ns : monotonic_now_ns();
+  if (hardware_ && !hardware_->start(start, error)) return false;
   running_.store(true);
   // The loop thread applies its own scheduling; start() waits for its verdict
   // so a required-but-refused setting stops the process before it runs.
@@ -133,22 +140,22 @@ void Runtime::loop_thread() {
 void Runtime::loop_tick(TimeNs now, const LoopStats& stats) noexcept {
   core_->tick(now, stats);
   const Snapshot& snap = core_->last_snapshot();
-  if (tap_) {
-    tap_->recorder().record_tick(now, snap.seq, core_->consumed(), core_->config().num_sensors);
+  std::uint32_t queued = publisher_->schedule(snap, now);
+  if (queued != 0) {
+    job_.snapshot = snap;
+    job_.due = queued;
+    if (!publish_jobs_.try_push(job_)) {
+      publish_drops_.fetch_add(1, std::memory_order_relaxed);
+      queued = 0;
+    }
   }
-  const std::uint32_t due = publisher_->schedule(snap, now);
-  if (due == 0) return;
-  job_.snapshot = snap;
-  job_.due = due;
-  if (!publish_jobs_.try_push(job_)) publish_drops_.fetch_add(1, std::memory_order_relaxed);
+  // What was queued, not what was due: a replay must publish what went out.
+  if (tap_) tap_->recorder().record_tick(now, snap.seq, core_->consumed(), core_->config().num_sensors, queued);
 }
 
 void Runtime::publisher_thread() {
   name_this_thread("rtfuse-pub");
-  LcmSink lcm_sink(*lcm_);
-  std::unique_ptr<runtime::RecordingSink> recording;
-  if (tap_) recording = std::make_unique<runtime::RecordingSink>(lcm_sink, tap_->recorder());
-  MessageSink& sink = recording ? static_cast<MessageSink&>(*recording) : lcm_sink;
+  MessageSink& sink = recording_sink_ ? static_cast<MessageSink&>(*recording_sink_) : *lcm_sink_;
   // The loop queues what is due; a 1 ms wake-up keeps outputs within a
   // millisecond of their tick at any rate.
   const TimeNs period = 1'000'000;

@@ -77,6 +77,8 @@ class Runtime {
   std::unique_ptr<transport::LcmNode> lcm_;
   std::unique_ptr<Hardware> hardware_;
   std::unique_ptr<RecordingTap> tap_;
+  std::unique_ptr<MessageSink> lcm_sink_;
+  std::unique_ptr<runtime::RecordingSink> recording_sink_;
   hal::MonotonicClock clock_;
   // Snapshots are large: a few slots cover the publisher thread waking late.
   SpscRing<PublishJob> publish_jobs_{8};

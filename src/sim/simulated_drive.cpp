@@ -46,7 +46,7 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
   HalBuses buses = robot->buses();
   std::unique_ptr<RecordingTap> tap;
   if (!options.record_path.empty()) {
-    tap = RecordingTap::create(options.record_path, core->config(), options.config_text, buses, clock, &error);
+    tap = RecordingTap::create(options.record_path, core->config(), options.config_text, buses, clock, t0, &error);
     if (!tap || !tap->recorder().start(&error)) {
       result.error = error;
       return result;
@@ -97,8 +97,9 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
     ++loop.ticks;
     core->tick(t, loop);
     const Snapshot& snap = core->last_snapshot();
-    if (tap) tap->recorder().record_tick(t, snap.seq, core->consumed(), core->config().num_sensors);
-    publisher.publish(snap, publisher.schedule(snap, t), t, sink);
+    const std::uint32_t due = publisher.schedule(snap, t);
+    if (tap) tap->recorder().record_tick(t, snap.seq, core->consumed(), core->config().num_sensors, due);
+    publisher.publish(snap, due, t, sink);
     const TruthState truth = robot->truth_at(t);
     if (t >= next_truth) {
       next_truth += truth_period;

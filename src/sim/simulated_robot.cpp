@@ -25,8 +25,29 @@ std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg,
   if (hw.can.enabled) {
     for (int i = 0; i < hw.can.num_nodes; ++i) {
       const int id = hw.can.nodes[static_cast<std::size_t>(i)].node_id;
+      const WheelNodeConfig& n = hw.can.nodes[static_cast<std::size_t>(i)];
       bool found = false;
-      for (int w = 0; w < body.wheel_count; ++w) found = found || body.wheels[static_cast<std::size_t>(w)].node_id == id;
+      for (int w = 0; w < body.wheel_count; ++w) {
+        const SimWheel& wheel = body.wheels[static_cast<std::size_t>(w)];
+        if (wheel.node_id != id) continue;
+        found = true;
+        // A counter of another width or signedness unwraps at the wrong
+        // place: jumps and wrong counts, with no error to say why.
+        if (n.position_bits != body.encoder_bits || n.position_signed != body.encoder_signed) {
+          *error = cfg.source + ": can.node[" + std::to_string(i) + "] reads a " + std::to_string(n.position_bits) +
+                   "-bit " + (n.position_signed ? "signed" : "unsigned") + " position but the simulated encoder in " +
+                   path + " counts " + std::to_string(body.encoder_bits) + "-bit " +
+                   (body.encoder_signed ? "signed" : "unsigned");
+          return nullptr;
+        }
+        const bool inverted = wheel.left ? body.invert_left : body.invert_right;
+        if ((n.sign < 0) != inverted) {
+          *error = cfg.source + ": can.node[" + std::to_string(i) + "].sign = " + std::to_string(n.sign) +
+                   " but the simulated encoder in " + path + (inverted ? " counts down" : " counts up") +
+                   " driving forward";
+          return nullptr;
+        }
+      }
       if (!found) {
         *error = cfg.source + ": can.node[" + std::to_string(i) + "].node_id = " + std::to_string(id) +
                  " is not an encoder of the simulated robot in " + path;

@@ -484,7 +484,7 @@ bool HalRecordCodec::decode(std::string_view channel, const void* data, int size
 }
 
 int HalRecordCodec::encode_tick(TimeNs time_ns, std::int64_t seq, const std::int64_t* consumed, int n,
-                                std::uint8_t* buf, int capacity) {
+                                std::uint32_t published, std::uint8_t* buf, int capacity) {
   if (n < 0 || n > kMaxTickSensors || (n > 0 && consumed == nullptr)) return -1;
   rtfuse::loop_tick_t& m = msgs_->tick;
   m.utime = ns_to_utime(time_ns);
@@ -492,6 +492,7 @@ int HalRecordCodec::encode_tick(TimeNs time_ns, std::int64_t seq, const std::int
   m.seq = seq;
   m.num_sensors = n;
   m.consumed.assign(consumed, consumed + n);
+  m.published = static_cast<std::int32_t>(published);
   return encode_into(m, buf, capacity);
 }
 
@@ -507,6 +508,7 @@ bool HalRecordCodec::decode_tick(const void* data, int size, LoopTick* out, std:
   out->time_ns = m.time_ns;
   out->seq = m.seq;
   out->consumed = std::move(m.consumed);
+  out->published = static_cast<std::uint32_t>(m.published);
   return true;
 }
 

@@ -28,7 +28,7 @@
 namespace rtfuse::transport {
 
 // Bump when a rtfuse/hal/* or rtfuse/rec/* record changes meaning or layout.
-constexpr std::int32_t kHalRecordFormatVersion = 1;
+constexpr std::int32_t kHalRecordFormatVersion = 2;
 
 constexpr std::string_view kRecordingInfoChannel = "rtfuse/rec/info";
 constexpr std::string_view kLoopTickChannel = "rtfuse/rec/tick";
@@ -81,6 +81,7 @@ struct LoopTick {
   TimeNs time_ns = 0;
   std::int64_t seq = 0;
   std::vector<std::int64_t> consumed;  // per sensor, cumulative up to and including this tick
+  std::uint32_t published = 0;         // outputs queued for publishing at this tick
 };
 
 class HalRecordCodec {
@@ -103,7 +104,8 @@ class HalRecordCodec {
   bool decode(std::string_view channel, const void* data, int size, hal::BusEvent* out, std::string* error);
 
   // loop_tick_t; -1 when n is outside 0..kMaxTickSensors or it does not fit.
-  int encode_tick(TimeNs time_ns, std::int64_t seq, const std::int64_t* consumed, int n, std::uint8_t* buf,
+  int encode_tick(TimeNs time_ns, std::int64_t seq, const std::int64_t* consumed, int n, std::uint32_t published,
+                  std::uint8_t* buf,
                   int capacity);
   static bool decode_tick(const void* data, int size, LoopTick* out, std::string* error);
 

@@ -102,6 +102,23 @@ TEST(SimulatedDrive, NodeIdTheRobotDoesNotHaveIsNamed) {
   std::remove(opt.scenario_path.c_str());
 }
 
+TEST(SimulatedDrive, EncoderWidthOrDirectionTheRobotDoesNotHaveIsNamed) {
+  const RuntimeConfig cfg = load_sim_toml();  // 32-bit unsigned, counting up
+  DriveOptions opt;
+  opt.scenario_path = variant_of_straight("bits16", {{"encoder_bits = 32", "encoder_bits = 16"}});
+  DriveResult r = run_simulated_drive(cfg, opt, nullptr);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, kSimToml + ": can.node[0] reads a 32-bit unsigned position but the simulated encoder in " +
+                         opt.scenario_path + " counts 16-bit unsigned");
+  std::remove(opt.scenario_path.c_str());
+  opt.scenario_path = variant_of_straight("inverted", {{"[robot]", "[robot]\ninvert_right = true"}});
+  r = run_simulated_drive(cfg, opt, nullptr);
+  EXPECT_FALSE(r.ok);
+  EXPECT_EQ(r.error, kSimToml + ": can.node[1].sign = 1 but the simulated encoder in " + opt.scenario_path +
+                         " counts down driving forward");
+  std::remove(opt.scenario_path.c_str());
+}
+
 TEST(SimulatedDrive, SameDriveTwiceIsBitIdentical) {
   const RuntimeConfig cfg = load_sim_toml();
   DriveOptions opt;

@@ -239,11 +239,11 @@ TEST(HalRecordCodec, EncodingStopsAllocatingOnceWarm) {
   std::uint8_t buf[kMaxHalRecordSize];
   for (const BusEvent& ev : evs) ASSERT_GT(codec.encode(ev, buf, sizeof buf), 0);
   const std::int64_t consumed[3] = {1, 2, 3};
-  ASSERT_GT(codec.encode_tick(1, 1, consumed, 3, buf, sizeof buf), 0);
+  ASSERT_GT(codec.encode_tick(1, 1, consumed, 3, 0u, buf, sizeof buf), 0);
   rtfuse::test::AllocScope scope;
   for (int i = 0; i < 3; ++i) {
     for (const BusEvent& ev : evs) codec.encode(ev, buf, sizeof buf);
-    codec.encode_tick(2, 2, consumed, 3, buf, sizeof buf);
+    codec.encode_tick(2, 2, consumed, 3, 0u, buf, sizeof buf);
   }
   EXPECT_EQ(scope.count(), 0u);
 }
@@ -252,7 +252,7 @@ TEST(HalRecordCodec, TicksRoundTrip) {
   HalRecordCodec codec({});
   const std::int64_t consumed[4] = {10, 0, 7, 123'456'789'012};
   std::uint8_t buf[kMaxHalRecordSize];
-  const int n = codec.encode_tick(9'000'000'005, 77, consumed, 4, buf, sizeof buf);
+  const int n = codec.encode_tick(9'000'000'005, 77, consumed, 4, 0x25u, buf, sizeof buf);
   ASSERT_GT(n, 0);
   LoopTick tick;
   std::string err;
@@ -260,7 +260,8 @@ TEST(HalRecordCodec, TicksRoundTrip) {
   EXPECT_EQ(tick.time_ns, 9'000'000'005);
   EXPECT_EQ(tick.seq, 77);
   EXPECT_EQ(tick.consumed, (std::vector<std::int64_t>{10, 0, 7, 123'456'789'012}));
-  EXPECT_EQ(codec.encode_tick(0, 0, consumed, kMaxTickSensors + 1, buf, sizeof buf), -1);
+  EXPECT_EQ(tick.published, 0x25u);
+  EXPECT_EQ(codec.encode_tick(0, 0, consumed, kMaxTickSensors + 1, 0u, buf, sizeof buf), -1);
 }
 
 TEST(HalRecordingInfo, RoundTripsAndChecksTheVersion) {
@@ -281,11 +282,13 @@ TEST(HalRecordingInfo, RoundTripsAndChecksTheVersion) {
   EXPECT_EQ(back.devices[2].kind, DeviceKind::kGpioEdge);
   EXPECT_EQ(back.devices[2].stream, 1);
 
-  RecordingInfo v2 = info;
-  v2.format_version = 2;
-  const std::vector<std::uint8_t> newer = encode_recording_info(v2);
+  RecordingInfo newer_info = info;
+  newer_info.format_version = kHalRecordFormatVersion + 1;
+  const std::vector<std::uint8_t> newer = encode_recording_info(newer_info);
   EXPECT_FALSE(decode_recording_info(newer.data(), static_cast<int>(newer.size()), &back, &err));
-  EXPECT_NE(err.find("format version 2, this rtfuse reads version 1"), std::string::npos) << err;
+  const std::string expected = "format version " + std::to_string(kHalRecordFormatVersion + 1) +
+                               ", this rtfuse reads version " + std::to_string(kHalRecordFormatVersion);
+  EXPECT_NE(err.find(expected), std::string::npos) << err;
 }
 
 TEST(HalRecordingInfo, ValidationNamesTheBadDevice) {
@@ -326,7 +329,7 @@ void write_recording(const std::string& path, const std::vector<BusEvent>& evs, 
     ASSERT_GT(n, 0);
     ASSERT_TRUE(w.write(ns_to_utime(ev.time_ns), codec.channel(ev.device), buf, static_cast<std::size_t>(n), &err));
     const std::int64_t consumed[2] = {seq, 2 * seq};
-    const int t = codec.encode_tick(seq * 5'000'000, seq, consumed, 2, buf, sizeof buf);
+    const int t = codec.encode_tick(seq * 5'000'000, seq, consumed, 2, 0u, buf, sizeof buf);
     ASSERT_TRUE(w.write(seq * 5'000, std::string(kLoopTickChannel), buf, static_cast<std::size_t>(t), &err));
     ++seq;
   }
@@ -406,7 +409,7 @@ TEST(HalRecordingLoader, AnotherFormatVersionIsRefusedWithTheFix) {
   HalRecording rec;
   EXPECT_FALSE(load(log.path(), &rec, &err));
   EXPECT_NE(err.find("event 0 on rtfuse/rec/info: recorded in HAL record format version 7, this rtfuse reads "
-                     "version 1: replay it with the rtfuse version that recorded it"),
+                     "version 2: replay it with the rtfuse version that recorded it"),
             std::string::npos)
       << err;
 }
