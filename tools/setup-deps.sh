@@ -13,6 +13,7 @@ packages=(
   python3 python3-rosbag python3-yaml python3-matplotlib
   iproute2 util-linux
   linux-libc-dev libgpiod-dev
+  binutils libc6-dev
 )
 
 missing=()
