@@ -1,6 +1,8 @@
 #include "runtime/recorder.hpp"
 
 #include <gtest/gtest.h>
+
+#include "support/temp_file.hpp"
 #include <unistd.h>
 
 #include <cstdio>
@@ -25,15 +27,10 @@ using transport::DeviceKind;
 using transport::HalRecording;
 using transport::RecordingInfo;
 
-class TempLog {
+// A log path of this test, removed afterwards.
+class TempLog : public test::TempFile {
  public:
-  explicit TempLog(const std::string& name)
-      : path_(testing::TempDir() + "rtfuse_rec_" + name + "_" + std::to_string(::getpid()) + ".lcm") {}
-  ~TempLog() { std::remove(path_.c_str()); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
+  explicit TempLog(const std::string& name) : TempFile("rec_" + name, ".lcm") {}
 };
 
 RecordingInfo make_info() {

@@ -1,6 +1,8 @@
 #include "transport/event_log.hpp"
 
 #include <gtest/gtest.h>
+
+#include "support/temp_file.hpp"
 #include <lcm/eventlog.h>
 #include <unistd.h>
 
@@ -15,16 +17,10 @@ namespace rtfuse::transport {
 namespace {
 
 // A per-test file in the temp dir, removed afterwards.
-class TempLog {
+// A log path of this test, removed afterwards.
+class TempLog : public test::TempFile {
  public:
-  explicit TempLog(const std::string& name)
-      : path_(testing::TempDir() + "rtfuse_" + name + "_" + std::to_string(::getpid()) +
-              ".lcmlog") {}
-  ~TempLog() { std::remove(path_.c_str()); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
+  explicit TempLog(const std::string& name) : TempFile(name, ".lcmlog") {}
 };
 
 std::vector<std::uint8_t> payload(int event, std::size_t size) {

@@ -1,6 +1,8 @@
 #include "transport/hal_record_codec.hpp"
 
 #include <gtest/gtest.h>
+
+#include "support/temp_file.hpp"
 #include <unistd.h>
 
 #include <cstdio>
@@ -21,15 +23,10 @@ using hal::BusEventKind;
 using hal::CanBusState;
 using hal::HalStatus;
 
-class TempLog {
+// A log path of this test, removed afterwards.
+class TempLog : public test::TempFile {
  public:
-  explicit TempLog(const std::string& name)
-      : path_(testing::TempDir() + "rtfuse_codec_" + name + "_" + std::to_string(::getpid()) + ".lcm") {}
-  ~TempLog() { std::remove(path_.c_str()); }
-  const std::string& path() const { return path_; }
-
- private:
-  std::string path_;
+  explicit TempLog(const std::string& name) : TempFile("codec_" + name, ".lcm") {}
 };
 
 RecordingInfo make_info() {
