@@ -27,16 +27,17 @@ find_program(JAVAC_EXECUTABLE javac NO_CMAKE_FIND_ROOT_PATH)
 find_program(JAR_EXECUTABLE jar NO_CMAKE_FIND_ROOT_PATH)
 find_file(LCM_JAR lcm.jar PATHS /usr/share/java /usr/local/share/java NO_CMAKE_FIND_ROOT_PATH)
 
-# toml++ (header-only in use; the Debian package also ships a compiled lib)
-find_package(tomlplusplus QUIET)
-if(TARGET tomlplusplus::tomlplusplus)
-  add_library(rtfuse_toml INTERFACE)
-  target_link_libraries(rtfuse_toml INTERFACE tomlplusplus::tomlplusplus)
-else()
-  find_path(TOMLPP_INCLUDE_DIR toml++/toml.h REQUIRED)
-  add_library(rtfuse_toml INTERFACE)
-  target_include_directories(rtfuse_toml SYSTEM INTERFACE ${TOMLPP_INCLUDE_DIR})
+# toml++, header-only: Debian's package config links the compiled
+# libtomlplusplus.so.3, which a board's OS (JetPack's Ubuntu 18.04) does not
+# have. Configs are parsed once at start-up, so the header-only build costs
+# only compile time and leaves one runtime dependency fewer.
+find_path(TOMLPP_INCLUDE_DIR toml++/toml.h)
+if(NOT TOMLPP_INCLUDE_DIR)
+  message(FATAL_ERROR "toml++ not found: install libtomlplusplus-dev")
 endif()
+add_library(rtfuse_toml INTERFACE)
+target_include_directories(rtfuse_toml SYSTEM INTERFACE ${TOMLPP_INCLUDE_DIR})
+target_compile_definitions(rtfuse_toml INTERFACE TOML_HEADER_ONLY=1)
 
 find_package(CLI11 QUIET CONFIG)
 if(NOT TARGET CLI11::CLI11)

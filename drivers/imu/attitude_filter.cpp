@@ -130,7 +130,9 @@ void AttitudeFilter::clamp_bias() noexcept {
 
 void AttitudeFilter::init_tilt(const Eigen::Vector3d& accel, double yaw) noexcept {
   const double roll = std::atan2(accel.y(), accel.z());
-  const double pitch = std::atan2(-accel.x(), std::hypot(accel.y(), accel.z()));
+  // Not std::hypot: glibc's hypot rounds differently on x86-64 and aarch64,
+  // and a recording made on the robot must replay bit-exactly on a laptop.
+  const double pitch = std::atan2(-accel.x(), std::sqrt(accel.y() * accel.y() + accel.z() * accel.z()));
   q_ = Eigen::AngleAxisd(yaw, Eigen::Vector3d::UnitZ()) * Eigen::AngleAxisd(pitch, Eigen::Vector3d::UnitY()) *
        Eigen::AngleAxisd(roll, Eigen::Vector3d::UnitX());
   q_.normalize();
