@@ -14,6 +14,14 @@ packages=(
   iproute2 util-linux
   linux-libc-dev libgpiod-dev
   binutils libc6-dev
+  # the aarch64 stage (tools/test-cross.sh): cross compiler, user-mode
+  # emulation, and the arm64 package installed in a clean arm64 root
+  g++-aarch64-linux-gnu qemu-user qemu-user-static binfmt-support debootstrap file
+  # the package test (tests/package): systemd-analyze verify of the unit
+  systemd
+  # tools/deploy.sh (ssh), and its test (tests/deploy) boots a board with
+  # systemd-nspawn from a debootstrap root
+  openssh-client systemd-container
 )
 
 missing=()
