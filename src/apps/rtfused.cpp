@@ -28,6 +28,10 @@
 #include "sim/sim_robot.hpp"
 #include "sim/simulated_robot.hpp"
 
+#ifndef RTFUSE_VERSION  // set by src/apps/CMakeLists.txt from project(VERSION)
+#define RTFUSE_VERSION "unknown"
+#endif
+
 namespace rtfuse::apps {
 extern const std::string_view kEmbeddedSimConfig;
 extern const std::string_view kEmbeddedDemoScenario;
@@ -77,6 +81,7 @@ int main(int argc, char** argv) {
   double duration = 0.0;
   std::string lcm_url;
   bool quiet = false;
+  app.set_version_flag("--version", "rtfused " RTFUSE_VERSION);
   app.add_option("-c,--config", config_path, "TOML config (default: the embedded config/sim.toml)");
   app.add_option("-d,--duration", duration, "stop after this many seconds (0: run until SIGINT/SIGTERM)")
       ->check([](const std::string& v) {
