@@ -25,7 +25,7 @@
 #include "runtime/realtime.hpp"
 #include "runtime/runtime.hpp"
 #include "sim/ground_truth.hpp"
-#include "sim/sim_robot.hpp"
+#include "sim/lcm_sim_robot.hpp"
 #include "sim/simulated_robot.hpp"
 
 #ifndef RTFUSE_VERSION  // set by src/apps/CMakeLists.txt from project(VERSION)
@@ -46,7 +46,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop.store(true); }
 
-void sim_thread(rtfuse::sim::SimRobot* sim, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
+void sim_thread(rtfuse::sim::LcmSimRobot* sim, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
   rtfuse::name_this_thread("rtfuse-sim");
   rtfuse::sim::SimMessage msg;
   while (run->load(std::memory_order_relaxed)) {
@@ -150,8 +150,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtfused: %s\n", error.c_str());
     return 1;
   }
-  std::unique_ptr<rtfuse::sim::SimRobot> sim;
-  if (cfg.sim.enabled) sim = std::make_unique<rtfuse::sim::SimRobot>(cfg.sim, rtfuse::monotonic_now_ns());
+  std::unique_ptr<rtfuse::sim::LcmSimRobot> sim;
+  if (cfg.sim.enabled) sim = std::make_unique<rtfuse::sim::LcmSimRobot>(cfg.sim, rtfuse::monotonic_now_ns());
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;

@@ -59,7 +59,7 @@ struct PublishConfig {
 
 // The built-in simulated robot (config/sim.toml): a figure-eight drive with
 // ground truth, publishing imu_t and odometry_t on the sensors' channels.
-struct SimConfig {
+struct LcmSimConfig {
   bool enabled = false;
   std::uint64_t seed = 1;
   double figure_eight_radius_m = 3.0;
@@ -98,7 +98,7 @@ struct RuntimeConfig {
   int num_sensors = 0;
   std::array<StaticTransformConfig, kMaxStaticTransforms> static_transforms{};
   int num_static_transforms = 0;
-  SimConfig sim;
+  LcmSimConfig sim;
   HardwareConfig hardware;
 };
 

@@ -55,7 +55,7 @@ int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexc
     d.hardware_id = hw.can.interface.c_str();
     keys(d, kCanBusKeys, kCanBusKeyCount);
     for (int n = 0; n < hw.can.num_nodes; ++n) {
-      const WheelNodeConfig& node = hw.can.nodes[static_cast<std::size_t>(n)];
+      const CanNodeSection& node = hw.can.nodes[static_cast<std::size_t>(n)];
       DeviceStatus& e = out[slots.first_node + n];
       std::snprintf(buf, sizeof buf, "wheel %s node %d", node.side == WheelSideConfig::kLeft ? "left" : "right",
                     node.node_id);

@@ -2,6 +2,8 @@
 // Which devices a configuration drives and the counters each one reports, in
 // a fixed order: the publisher sizes its diagnostics message from this once,
 // and the loop fills the same slots every tick (runtime/hardware.cpp).
+#include <initializer_list>
+
 #include "runtime/config.hpp"
 #include "runtime/device_status.hpp"
 
@@ -31,5 +33,17 @@ extern const char* const kWheelOdometryKeys[];
 extern const int kWheelOdometryKeyCount;
 extern const char* const kImuKeys[];
 extern const int kImuKeyCount;
+
+// Values in the order of the layout's keys, so the names are written in
+// one place only.
+inline void set_device_values(DeviceStatus& d, const char* const* keys, int n,
+                              std::initializer_list<std::int64_t> values) noexcept {
+  d.num_values = 0;
+  int i = 0;
+  for (std::int64_t v : values) {
+    if (i == n) break;
+    d.add(keys[i++], v);
+  }
+}
 
 }  // namespace rtfuse

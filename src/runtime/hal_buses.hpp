@@ -1,8 +1,9 @@
 #pragma once
 // The bus primitives the drivers of one configuration run on, whatever
 // provides them: the kernel (runtime/linux_hal), the simulated robot
-// (sim/), or a recording (replay). Null where the configuration has no such
-// device. Not owned.
+// (sim/), or a recording (replay). One named slot per device thread, each
+// with the clock that thread waits on; null where the configuration has no
+// such device. Not owned.
 #include "hal/can_bus.hpp"
 #include "hal/clock.hpp"
 #include "hal/gpio.hpp"
@@ -10,11 +11,17 @@
 
 namespace rtfuse {
 
+// The IMU thread's: the chip's bus, its data-ready line (null: poll at
+// mpu.poll_rate) and the clock for polling and reset delays.
+struct ImuBuses {
+  hal::I2cBus* i2c = nullptr;
+  hal::GpioEdgeSource* data_ready = nullptr;
+  hal::Clock* clock = nullptr;
+};
+
 struct HalBuses {
-  hal::CanBus* can = nullptr;            // polled by the loop thread
-  hal::I2cBus* i2c = nullptr;            // the IMU thread's
-  hal::GpioEdgeSource* drdy = nullptr;   // IMU data-ready line; null: poll at mpu.poll_rate
-  hal::Clock* imu_clock = nullptr;       // the IMU thread's clock (polling, reset delays)
+  hal::CanBus* can = nullptr;  // the wheel encoders' bus, polled by the loop thread
+  ImuBuses imu;
 };
 
 }  // namespace rtfuse

@@ -6,14 +6,12 @@
 #include <map>
 #include <vector>
 
-#include "hal/mock/replay_can_bus.hpp"
-#include "hal/mock/replay_clock.hpp"
-#include "hal/mock/replay_gpio.hpp"
-#include "hal/mock/replay_i2c_bus.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/hardware.hpp"
-#include "runtime/publisher.hpp"
+#include "hal/replay/replay_can_bus.hpp"
+#include "hal/replay/replay_clock.hpp"
+#include "hal/replay/replay_gpio.hpp"
+#include "hal/replay/replay_i2c_bus.hpp"
 #include "runtime/recording_tap.hpp"
+#include "runtime/tick_pipeline.hpp"
 
 namespace rtfuse {
 namespace {
@@ -85,6 +83,29 @@ class CompareSink final : public MessageSink {
   std::map<std::string, std::size_t> next_;
 };
 
+// Publishes what the live loop queued at the tick being replayed, no more,
+// no fewer; a tick whose bus calls ran past the recording (or off it) did
+// not happen as recorded and publishes nothing.
+class ReplayOutput final : public OutputStage {
+ public:
+  ReplayOutput(Publisher& publisher, MessageSink& sink, const transport::HalRecording& rec)
+      : publisher_(publisher), sink_(sink), rec_(rec) {}
+  void expect(std::uint32_t recorded) { recorded_ = recorded; }
+  std::uint32_t deliver(const Snapshot& snap, std::uint32_t, TimeNs now) noexcept override {
+    for (const auto& s : rec_.streams) {
+      if (s->diverged()) return 0;
+    }
+    publisher_.publish(snap, recorded_, now, sink_);
+    return recorded_;
+  }
+
+ private:
+  Publisher& publisher_;
+  MessageSink& sink_;
+  const transport::HalRecording& rec_;
+  std::uint32_t recorded_ = 0;
+};
+
 int stream_index(const transport::RecordingInfo& info, const char* name) {
   for (std::size_t i = 0; i < info.streams.size(); ++i) {
     if (info.streams[i] == name) return static_cast<int>(i);
@@ -116,31 +137,31 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   HalBuses buses;
   for (std::size_t d = 0; d < rec.info.devices.size(); ++d) {
     const transport::RecordedDevice& dev = rec.info.devices[d];
-    hal::mock::ReplayStream& stream = *rec.streams[static_cast<std::size_t>(dev.stream)];
+    hal::replay::ReplayStream& stream = *rec.streams[static_cast<std::size_t>(dev.stream)];
     const auto index = static_cast<std::uint8_t>(d);
     switch (dev.kind) {
       case transport::DeviceKind::kCan:
         if (dev.stream == loop && buses.can == nullptr) {
-          cans.push_back(std::make_unique<hal::mock::ReplayCanBus>(stream, index));
+          cans.push_back(std::make_unique<hal::replay::ReplayCanBus>(stream, index));
           buses.can = cans.back().get();
         }
         break;
       case transport::DeviceKind::kI2c:
         if (dev.stream == imu && !i2c) {
-          i2c = std::make_unique<hal::mock::ReplayI2cBus>(stream, index);
-          buses.i2c = i2c.get();
+          i2c = std::make_unique<hal::replay::ReplayI2cBus>(stream, index);
+          buses.imu.i2c = i2c.get();
         }
         break;
       case transport::DeviceKind::kGpioEdge:
         if (dev.stream == imu && !drdy) {
-          drdy = std::make_unique<hal::mock::ReplayEdgeSource>(stream, index);
-          buses.drdy = drdy.get();
+          drdy = std::make_unique<hal::replay::ReplayEdgeSource>(stream, index);
+          buses.imu.data_ready = drdy.get();
         }
         break;
       case transport::DeviceKind::kClock:
         if (dev.stream == imu && !clock) {
-          clock = std::make_unique<hal::mock::ReplayClock>(stream, index);
-          buses.imu_clock = clock.get();
+          clock = std::make_unique<hal::replay::ReplayClock>(stream, index);
+          buses.imu.clock = clock.get();
         }
         break;
       case transport::DeviceKind::kGpioOutput: break;
@@ -151,7 +172,7 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     result.error = "the configuration has [can] but the recording has no CAN bus of the loop thread";
     return result;
   }
-  if (hw.mpu.enabled && (buses.i2c == nullptr || buses.imu_clock == nullptr)) {
+  if (hw.mpu.enabled && (buses.imu.i2c == nullptr || buses.imu.clock == nullptr)) {
     result.error = "the configuration has [mpu] but the recording has no I2C bus and clock of the IMU thread";
     return result;
   }
@@ -167,33 +188,25 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   }
 
   std::string err;
-  std::unique_ptr<FusionCore> core = FusionCore::create(cfg, &err);
-  if (!core) {
+  CompareSink sink(rec, cfg, out);
+  PipelineOptions options;
+  options.sink = &sink;
+  std::unique_ptr<TickPipeline> pipeline = TickPipeline::create(cfg, buses, options, &err);
+  if (!pipeline) {
     result.error = err;
     return result;
   }
-  std::unique_ptr<Hardware> hardware;
-  if (hw.can.enabled || hw.mpu.enabled) {
-    hardware = Hardware::create(buses, *core, &err);
-    if (!hardware) {
-      result.error = err;
-      return result;
-    }
-    core->set_devices(hardware.get());
-  }
-  Publisher publisher(core->config());
-  CompareSink sink(rec, cfg, out);
-
-  auto diverged = [&]() -> const hal::mock::ReplayStream* {
+  auto diverged = [&]() -> const hal::replay::ReplayStream* {
     for (const auto& s : rec.streams) {
       if (s->diverged()) return s.get();
     }
     return nullptr;
   };
+  ReplayOutput output(pipeline->publisher(), pipeline->sink(), rec);
   // A different call is a divergence; running out of recorded calls (a
   // truncated recording, a ring that overflowed) ends the replay early.
-  auto stop_diverged = [&](const hal::mock::ReplayStream& s) {
-    if (s.divergence_kind() == hal::mock::DivergenceKind::kMismatch) {
+  auto stop_diverged = [&](const hal::replay::ReplayStream& s) {
+    if (s.divergence_kind() == hal::replay::DivergenceKind::kMismatch) {
       result.diverged = true;
       result.error = "replay diverged from the recording in stream '" + s.name() + "': " + s.divergence();
     } else {
@@ -203,7 +216,7 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   };
 
   const TimeNs t0 = rec.info.start_ns != 0 ? rec.info.start_ns : (rec.ticks.empty() ? 0 : rec.ticks.front().time_ns);
-  if (hardware && !hardware->start(t0, &err)) {
+  if (!pipeline->start(t0, &err)) {
     if (const auto* s = diverged()) {
       stop_diverged(*s);
     } else {
@@ -211,47 +224,51 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     }
     return result;
   }
-  const int imu_sensor = hw.mpu_sensor;
+  // Each thread device replays the stream named after it.
+  const hal::replay::ReplayStream* device_streams[kMaxThreadDevices] = {};
+  for (int d = 0; d < pipeline->thread_device_count(); ++d) {
+    const int index = stream_index(rec.info, pipeline->thread_device(d).name());
+    if (index >= 0) device_streams[d] = rec.streams[static_cast<std::size_t>(index)].get();
+  }
   LoopStats loop_stats;
   loop_stats.rate_hz = cfg.rate_hz;
   loop_stats.period_ns = static_cast<std::int64_t>(1e9 / cfg.rate_hz);
   HalReplayProgress prog;
   prog.total_ticks = static_cast<std::int64_t>(rec.ticks.size());
   for (const transport::LoopTick& t : rec.ticks) {
-    if (hardware && hardware->has_imu() && imu_sensor >= 0 &&
-        static_cast<int>(t.consumed.size()) > imu_sensor) {
-      const std::int64_t target = t.consumed[static_cast<std::size_t>(imu_sensor)];
-      const hal::mock::ReplayStream& s = *rec.streams[static_cast<std::size_t>(imu)];
-      // The IMU thread ran ahead of the loop: replay its calls until the
-      // loop has what it took live. A stream that ends or diverges first
-      // cannot give more.
-      while (hardware->imu_samples() < target && !s.diverged() && !s.at_end()) {
-        hardware->imu_step(kImuEdgeTimeoutNs);
-      }
+    bool short_of_samples = false;
+    for (int d = 0; d < pipeline->thread_device_count() && !short_of_samples; ++d) {
+      ThreadDevice& device = pipeline->thread_device(d);
+      const hal::replay::ReplayStream* s = device_streams[d];
+      const int sensor = device.sensor();
+      if (s == nullptr || sensor < 0 || static_cast<int>(t.consumed.size()) <= sensor) continue;
+      const std::int64_t target = t.consumed[static_cast<std::size_t>(sensor)];
+      // The device's thread ran ahead of the loop: replay its calls until
+      // the loop has what it took live. A stream that ends or diverges
+      // first cannot give more.
+      while (device.samples() < target && !s->diverged() && !s->at_end()) device.step(kDeviceStepTimeoutNs);
       // Ticking on without the samples the live loop had would publish
       // something it never published: the recording ends here.
-      if (hardware->imu_samples() < target && !s.diverged()) {
+      if (device.samples() < target && !s->diverged()) {
         result.ended_early = true;
-        result.note = "the recording of stream '" + s.name() + "' ends before tick " + std::to_string(t.seq) +
-                      ": it holds " + std::to_string(hardware->imu_samples()) + " of the " +
-                      std::to_string(target) + " IMU samples the loop had taken by then";
-        break;
+        result.note = "the recording of stream '" + s->name() + "' ends before tick " + std::to_string(t.seq) +
+                      ": it holds " + std::to_string(device.samples()) + " of the " + std::to_string(target) +
+                      " " + device.name() + " samples the loop had taken by then";
+        short_of_samples = true;
       }
     }
+    if (short_of_samples) break;
     if (const auto* s = diverged()) {
       stop_diverged(*s);
       break;
     }
     ++loop_stats.ticks;
-    core->tick(t.time_ns, loop_stats);
-    // A tick whose bus calls ran past the recording (or off it) did not
-    // happen as recorded: stop before publishing it.
+    output.expect(t.published);
+    pipeline->step(t.time_ns, loop_stats, output);
     if (const auto* s = diverged()) {
       stop_diverged(*s);
       break;
     }
-    // The outputs the live loop queued at this tick, no more, no fewer.
-    publisher.publish(core->last_snapshot(), t.published, t.time_ns, sink);
     ++result.ticks;
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);
@@ -262,7 +279,7 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   result.identical = sink.identical;
   result.first_mismatch = sink.first_mismatch;
   result.recorded_not_reproduced = sink.not_reproduced();
-  core->snapshot().load(result.final);
+  pipeline->core().snapshot().load(result.final);
   if (!sink.error.empty()) {
     result.error = "writing the output log: " + sink.error;
     return result;

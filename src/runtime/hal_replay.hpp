@@ -21,10 +21,6 @@
 
 namespace rtfuse {
 
-// The edge wait every IMU step uses, live and in lockstep: the replay must
-// pass the same value for its calls to match the recorded ones.
-constexpr TimeNs kImuEdgeTimeoutNs = 50'000'000;
-
 struct HalReplayResult {
   bool ok = false;            // no set-up error and no divergence (ended_early: stopped before the last tick)
   std::string error;          // set up failed, or the divergence report

@@ -1,33 +1,26 @@
 #pragma once
-// The drivers a configuration runs, on whatever buses it is given (kernel,
-// simulated robot, recording): the CANopen encoders and wheel odometry,
-// polled by the loop inside its tick, and the MPU IMU, stepped by its own
-// thread. Their measurements enter the fusion through the same sensor rings
-// as decoded LCM messages, so fusion semantics do not depend on the source.
+// The devices a configuration drives, on whatever buses it is given (kernel,
+// simulated robot, recording): the ones the loop polls inside its tick (the
+// CANopen wheel encoders) and the ones on threads of their own (the IMU),
+// behind one ThreadDevice interface. Their measurements enter the fusion
+// through the same sensor rings as decoded LCM messages, so fusion semantics
+// do not depend on the source.
 //
 // Everything is allocated in create(); before_drain(), fill_snapshot() and
-// imu_step() (outside a chip re-initialisation) allocate nothing.
-#include <atomic>
+// the thread devices' steps (outside a re-initialisation) allocate nothing.
 #include <memory>
 #include <string>
 
-#include "core/seqlock.hpp"
-#include "drivers/canopen/canopen_encoders.hpp"
-#include "drivers/imu/mpu_imu.hpp"
-#include "drivers/wheel/wheel_odometry.hpp"
 #include "runtime/device_layout.hpp"
 #include "runtime/fusion_core.hpp"
 #include "runtime/hal_buses.hpp"
+#include "runtime/imu_device.hpp"
+#include "runtime/thread_device.hpp"
+#include "runtime/wheel_encoder_device.hpp"
 
 namespace rtfuse {
 
-// Driver configs from the TOML's plain values (also used by tools that
-// build the drivers themselves).
-drivers::CanopenEncodersConfig encoder_driver_config(const RuntimeConfig& cfg);
-drivers::WheelOdometryConfig wheel_driver_config(const RuntimeConfig& cfg);
-// base_R_imu comes from the frame tree: the static transform base_link -> mpu.frame.
-bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& frames, drivers::MpuImuConfig* out,
-                       std::string* error);
+constexpr int kMaxThreadDevices = 4;
 
 class Hardware final : public TickDevices {
  public:
@@ -42,46 +35,23 @@ class Hardware final : public TickDevices {
   void before_drain(TimeNs now) noexcept override;
   void fill_snapshot(Snapshot& s) noexcept override;
 
-  // IMU thread: wait for one data-ready edge (or the next poll), read, filter,
-  // push into the IMU sensor's ring.
-  bool has_imu() const { return imu_ != nullptr; }
-  drivers::StepResult imu_step(TimeNs edge_timeout_ns) noexcept;
-  // Samples pushed into the IMU sensor's ring so far (IMU thread's count).
-  std::int64_t imu_samples() const { return imu_samples_.load(std::memory_order_acquire); }
+  // The devices that want a thread (live) or lockstep steps (replay, simulation).
+  int thread_device_count() const { return num_threaded_; }
+  ThreadDevice& thread_device(int i) { return *threaded_[i]; }
 
-  const drivers::CanopenEncoders* encoders() const { return encoders_.get(); }
-  const drivers::WheelOdometry* wheel_odometry() const { return wheels_.get(); }
+  ImuDevice* imu() { return imu_.get(); }
+  const drivers::CanopenEncoders* encoders() const { return wheels_ ? &wheels_->encoders() : nullptr; }
+  const drivers::WheelOdometry* wheel_odometry() const { return wheels_ ? wheels_->wheel_odometry() : nullptr; }
 
  private:
-  explicit Hardware(const RuntimeConfig& cfg, FusionCore& core);
-  void fill_can(Snapshot& s) noexcept;
-  void fill_imu(Snapshot& s) noexcept;
+  explicit Hardware(const RuntimeConfig& cfg);
 
-  // What the IMU thread shares with the loop, through a seqlock.
-  struct ImuHealth {
-    drivers::MpuImuStats stats;
-    drivers::StepResult last = drivers::StepResult::kDown;
-    double temperature_c = 0.0;
-    std::int64_t last_sample_ns = 0;
-  };
-
-  const RuntimeConfig& cfg_;
-  FusionCore& core_;
   DeviceSlots slots_;
   DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
-  int base_frame_ = -1;
-  std::unique_ptr<drivers::CanopenEncoders> encoders_;
-  std::unique_ptr<drivers::WheelOdometry> wheels_;
-  std::unique_ptr<drivers::MpuImu> imu_;
-  drivers::WheelTwist last_twist_;
-  bool have_twist_ = false;
-  est::SensorSample wheel_sample_;
-  est::SensorSample imu_sample_;
-  drivers::ImuMeasurement imu_measurement_;
-  ImuHealth imu_health_scratch_;
-  SeqLock<ImuHealth> imu_health_;
-  std::atomic<std::int64_t> imu_samples_{0};
-  static_assert(std::atomic<std::int64_t>::is_always_lock_free);
+  std::unique_ptr<WheelEncoderDevice> wheels_;
+  std::unique_ptr<ImuDevice> imu_;
+  ThreadDevice* threaded_[kMaxThreadDevices] = {};
+  int num_threaded_ = 0;
 };
 
 }  // namespace rtfuse

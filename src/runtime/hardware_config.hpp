@@ -24,7 +24,7 @@ enum class AttitudeAlgorithmConfig : std::uint8_t { kMadgwick, kMahony };
 
 constexpr int kMaxWheelNodes = 8;
 
-struct WheelNodeConfig {
+struct CanNodeSection {
   std::uint8_t node_id = 1;
   WheelSideConfig side = WheelSideConfig::kLeft;
   int sign = 1;                      // -1 for the mirrored motor
@@ -34,7 +34,7 @@ struct WheelNodeConfig {
   bool position_signed = false;
 };
 
-struct CanConfig {
+struct CanSection {
   bool enabled = false;
   HwName interface{"can0"};
   std::uint32_t sync_cob_id = 0x080;
@@ -42,11 +42,11 @@ struct CanConfig {
   int tpdo_timeout_syncs = 5;
   double stuck_time_s = 0.5;
   double max_wheel_speed_mps = 5.0;  // beyond this a counter step is a glitch
-  std::array<WheelNodeConfig, kMaxWheelNodes> nodes{};
+  std::array<CanNodeSection, kMaxWheelNodes> nodes{};
   int num_nodes = 0;
 };
 
-struct WheelOdometryConfig {
+struct WheelOdometrySection {
   KinematicsConfig kinematics = KinematicsConfig::kDifferential;
   double track_width_m = 0.5;
   double wheel_radius_m = 0.1;
@@ -61,7 +61,7 @@ struct WheelOdometryConfig {
   double raw_rate_hz = 50.0;                    // 0: not published
 };
 
-struct AttitudeConfig {
+struct AttitudeSection {
   AttitudeAlgorithmConfig algorithm = AttitudeAlgorithmConfig::kMadgwick;
   double beta = 0.1;    // Madgwick gain
   double zeta = 0.005;  // Madgwick gyro-bias gain
@@ -69,7 +69,7 @@ struct AttitudeConfig {
   double ki = 0.02;     // Mahony integral gain (gyro bias)
 };
 
-struct MpuConfig {
+struct MpuSection {
   bool enabled = false;
   HwName device{"/dev/i2c-1"};
   std::uint8_t address = 0x68;
@@ -85,15 +85,15 @@ struct MpuConfig {
   int frozen_reads = 10;
   double gyro_noise_rad_s = 0.005;   // per-sample 1-sigma
   double accel_noise_mps2 = 0.05;
-  AttitudeConfig attitude;
+  AttitudeSection attitude;
 };
 
 struct HardwareConfig {
   HalBackend backend = HalBackend::kNone;
   std::string scenario;  // backend "sim": the drive scenario file (resolved path)
-  CanConfig can;
-  WheelOdometryConfig wheel_odometry;
-  MpuConfig mpu;
+  CanSection can;
+  WheelOdometrySection wheel_odometry;
+  MpuSection mpu;
   int wheel_sensor = -1;  // index of the [[sensor]] with source = "wheel_odometry"
   int mpu_sensor = -1;    // index of the [[sensor]] with source = "mpu"
 };

@@ -44,7 +44,7 @@ void read_backend(const Section& s, HardwareConfig& hw, const std::string& confi
   }
 }
 
-void read_node(const Section& s, WheelNodeConfig& n) {
+void read_node(const Section& s, CanNodeSection& n) {
   s.reject_unknown({"node_id", "side", "sign", "tpdo_cob_id", "position_offset", "position_bits",
                     "position_signed"});
   s.require({"node_id", "side"});
@@ -92,7 +92,7 @@ void read_node(const Section& s, WheelNodeConfig& n) {
   s.read("position_signed", n.position_signed);
 }
 
-void read_can(const Section& s, CanConfig& can) {
+void read_can(const Section& s, CanSection& can) {
   s.reject_unknown({"interface", "sync_cob_id", "heartbeat_timeout", "tpdo_timeout_syncs", "stuck_time",
                     "max_wheel_speed", "node"});
   can.enabled = true;
@@ -112,7 +112,7 @@ void read_can(const Section& s, CanConfig& can) {
   read_number(s, "max_wheel_speed", can.max_wheel_speed_mps, positive_finite, "must be > 0 m/s and finite");
   bool left = false, right = false;
   for_each_table(s, "node", kMaxWheelNodes, [&](const Section& n, bool fits) {
-    WheelNodeConfig node;
+    CanNodeSection node;
     read_node(n, node);
     for (int j = 0; j < can.num_nodes; ++j) {
       if (can.nodes[static_cast<std::size_t>(j)].node_id == node.node_id) {
@@ -133,7 +133,7 @@ void read_can(const Section& s, CanConfig& can) {
   }
 }
 
-void read_wheel_odometry(const Section& s, WheelOdometryConfig& w) {
+void read_wheel_odometry(const Section& s, WheelOdometrySection& w) {
   s.reject_unknown({"kinematics", "track_width", "wheel_radius", "counts_per_rev", "gear_ratio",
                     "skid_track_factor", "speed_noise", "yaw_rate_noise", "slip", "lateral_noise",
                     "raw_channel", "raw_rate"});
@@ -169,7 +169,7 @@ void read_wheel_odometry(const Section& s, WheelOdometryConfig& w) {
   }
 }
 
-void read_attitude(const Section& s, AttitudeConfig& a) {
+void read_attitude(const Section& s, AttitudeSection& a) {
   s.reject_unknown({"algorithm", "beta", "zeta", "kp", "ki"});
   std::string alg;
   if (s.read("algorithm", alg)) {
@@ -194,7 +194,7 @@ void read_attitude(const Section& s, AttitudeConfig& a) {
   read_number(s, "ki", a.ki, non_negative_finite, "must be >= 0 and finite");
 }
 
-void read_mpu(const Section& s, MpuConfig& m) {
+void read_mpu(const Section& s, MpuSection& m) {
   s.reject_unknown({"device", "address", "model", "sample_rate_divider", "dlpf", "gyro_range", "accel_range",
                     "data_ready_chip", "data_ready_line", "poll_rate", "frame", "frozen_reads", "gyro_noise",
                     "accel_noise", "attitude"});

@@ -17,10 +17,10 @@ struct LinuxHal::Devices {
 LinuxHal::LinuxHal() : devices_(std::make_unique<Devices>()) {}
 LinuxHal::~LinuxHal() = default;
 
-int encoder_can_ids(const CanConfig& can, std::uint32_t* ids, int max) {
+int encoder_can_ids(const CanSection& can, std::uint32_t* ids, int max) {
   int n = 0;
   for (int i = 0; i < can.num_nodes; ++i) {
-    const WheelNodeConfig& node = can.nodes[static_cast<std::size_t>(i)];
+    const CanNodeSection& node = can.nodes[static_cast<std::size_t>(i)];
     const std::uint32_t tpdo = node.tpdo_cob_id != 0 ? node.tpdo_cob_id : 0x180u + node.node_id;
     for (std::uint32_t id : {tpdo, 0x700u + node.node_id, 0x080u + node.node_id}) {
       if (n < max) ids[n++] = id;
@@ -45,15 +45,15 @@ std::unique_ptr<LinuxHal> LinuxHal::open(const RuntimeConfig& cfg, std::string* 
   if (hw.mpu.enabled) {
     d.i2c = hal::I2cDevBus::open(hw.mpu.device.c_str(), hal::I2cRetryPolicy{}, error);
     if (!d.i2c) return nullptr;
-    h->buses_.i2c = d.i2c.get();
+    h->buses_.imu.i2c = d.i2c.get();
     if (!hw.mpu.data_ready_chip.empty()) {
       d.drdy = hal::GpiodEdgeSource::open(hw.mpu.data_ready_chip.c_str(),
                                           static_cast<unsigned>(hw.mpu.data_ready_line), hal::EdgeKind::kRising,
                                           error);
       if (!d.drdy) return nullptr;
-      h->buses_.drdy = d.drdy.get();
+      h->buses_.imu.data_ready = d.drdy.get();
     }
-    h->buses_.imu_clock = &d.clock;
+    h->buses_.imu.clock = &d.clock;
   }
   return h;
 }

@@ -26,6 +26,6 @@ class LinuxHal {
 
 // The COB-IDs the encoder driver listens to (TPDO, heartbeat, EMCY of every
 // node): the kernel drops everything else before it reaches the loop.
-int encoder_can_ids(const CanConfig& can, std::uint32_t* ids, int max);
+int encoder_can_ids(const CanSection& can, std::uint32_t* ids, int max);
 
 }  // namespace rtfuse

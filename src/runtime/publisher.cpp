@@ -197,7 +197,7 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
   m.diagnostics.finalize();
   for (auto& d : m.diagnostics.msg.devices) d.state = "starting";
 
-  const WheelOdometryConfig& w = c.hardware.wheel_odometry;
+  const WheelOdometrySection& w = c.hardware.wheel_odometry;
   m.wheel_channel = w.raw_channel;
   m.wheel_odometry.channel = m.wheel_channel.c_str();
   m.wheel_odometry.schedule.set_rate(c.hardware.wheel_sensor >= 0 ? w.raw_rate_hz : 0.0);

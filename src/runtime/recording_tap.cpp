@@ -39,9 +39,9 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
     return static_cast<int>(info.devices.size()) - 1;
   };
   if (inner.can != nullptr) can = add(can_device_name(cfg), transport::DeviceKind::kCan, 0);
-  if (inner.i2c != nullptr) i2c = add(i2c_device_name(cfg), transport::DeviceKind::kI2c, 1);
-  if (inner.drdy != nullptr) drdy = add("imu-drdy", transport::DeviceKind::kGpioEdge, 1);
-  if (inner.imu_clock != nullptr && inner.i2c != nullptr) {
+  if (inner.imu.i2c != nullptr) i2c = add(i2c_device_name(cfg), transport::DeviceKind::kI2c, 1);
+  if (inner.imu.data_ready != nullptr) drdy = add("imu-drdy", transport::DeviceKind::kGpioEdge, 1);
+  if (inner.imu.clock != nullptr && inner.imu.i2c != nullptr) {
     imu_clock = add("imu-clock", transport::DeviceKind::kClock, 1);
   }
   runtime::RecorderRingSizes sizes;
@@ -59,18 +59,18 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
     b.can = t->can_.get();
   }
   if (i2c >= 0) {
-    t->i2c_ = std::make_unique<hal::RecordingI2cBus>(*inner.i2c, r.ring(1), static_cast<std::uint8_t>(i2c), &clock);
-    b.i2c = t->i2c_.get();
+    t->i2c_ = std::make_unique<hal::RecordingI2cBus>(*inner.imu.i2c, r.ring(1), static_cast<std::uint8_t>(i2c), &clock);
+    b.imu.i2c = t->i2c_.get();
   }
   if (drdy >= 0) {
     t->drdy_ =
-        std::make_unique<hal::RecordingEdgeSource>(*inner.drdy, r.ring(1), static_cast<std::uint8_t>(drdy), &clock);
-    b.drdy = t->drdy_.get();
+        std::make_unique<hal::RecordingEdgeSource>(*inner.imu.data_ready, r.ring(1), static_cast<std::uint8_t>(drdy), &clock);
+    b.imu.data_ready = t->drdy_.get();
   }
   if (imu_clock >= 0) {
     t->imu_clock_ =
-        std::make_unique<hal::RecordingClock>(*inner.imu_clock, r.ring(1), static_cast<std::uint8_t>(imu_clock));
-    b.imu_clock = t->imu_clock_.get();
+        std::make_unique<hal::RecordingClock>(*inner.imu.clock, r.ring(1), static_cast<std::uint8_t>(imu_clock));
+    b.imu.clock = t->imu_clock_.get();
   }
   return t;
 }

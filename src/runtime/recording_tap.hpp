@@ -18,6 +18,8 @@
 
 namespace rtfuse {
 
+// Streams are named after their thread: the loop, and each thread device
+// by its name() (the IMU's is "imu").
 constexpr const char* kLoopStream = "loop";
 constexpr const char* kImuStream = "imu";
 

@@ -1,9 +1,10 @@
 #pragma once
-// The live runtime: the fixed-rate loop thread (rtfuse-loop), the publisher
-// thread (rtfuse-pub), the LCM input thread (rtfuse-lcmin) and, with an IMU
-// driver, the IMU thread (rtfuse-imu) around one FusionCore; with a
-// recording, the recorder's writer (rtfuse-rec). Everything is allocated in
-// create(); the threads allocate nothing once running.
+// The live room around the tick pipeline: the fixed-rate loop thread
+// (rtfuse-loop) with its timer and real-time settings, the publisher thread
+// (rtfuse-pub), the LCM input thread (rtfuse-lcmin) and one thread per
+// thread device (rtfuse-imu, ...); with a recording, the recorder's writer
+// (rtfuse-rec). Everything is allocated in create(); the threads allocate
+// nothing once running.
 //
 // Which snapshots are published is decided by the loop on tick time
 // (Publisher::schedule) and handed to the publisher thread through a ring,
@@ -16,11 +17,8 @@
 
 #include "core/spsc_ring.hpp"
 #include "hal/linux/monotonic_clock.hpp"
-#include "runtime/fusion_core.hpp"
 #include "runtime/hal_buses.hpp"
-#include "runtime/hardware.hpp"
-#include "runtime/publisher.hpp"
-#include "runtime/recording_tap.hpp"
+#include "runtime/tick_pipeline.hpp"
 #include "transport/lcm_node.hpp"
 
 namespace rtfuse {
@@ -55,30 +53,37 @@ class Runtime {
 
   Snapshot latest() const;
   transport::LcmNode& lcm() { return *lcm_; }
-  const RuntimeConfig& config() const { return core_->config(); }
+  const RuntimeConfig& config() const { return pipeline_->config(); }
   // Set by the loop after its first steady tick; tests and tools use it to
   // know when start-up allocations are over.
   bool steady() const { return steady_.load(std::memory_order_acquire); }
   // Snapshots the publisher thread could not take in time (ring full).
   std::int64_t publish_drops() const { return publish_drops_.load(std::memory_order_relaxed); }
-  const RecordingTap* recording() const { return tap_.get(); }
+  const RecordingTap* recording() const { return pipeline_->tap(); }
 
  private:
+  // The loop's outputs go to the publisher thread through a ring; a full
+  // ring drops the snapshot (counted) and the tick records that nothing went.
+  class QueuedOutput final : public OutputStage {
+   public:
+    explicit QueuedOutput(Runtime& rt) : rt_(rt) {}
+    std::uint32_t deliver(const Snapshot& snap, std::uint32_t due, TimeNs now) noexcept override;
+
+   private:
+    Runtime& rt_;
+  };
+
   Runtime() = default;
   void loop_thread();
-  void loop_tick(TimeNs now, const LoopStats& stats) noexcept;
   void publisher_thread();
   void input_thread();
-  void imu_thread();
+  void device_thread(ThreadDevice* device);
   static void on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
 
-  std::unique_ptr<FusionCore> core_;
-  std::unique_ptr<Publisher> publisher_;
   std::unique_ptr<transport::LcmNode> lcm_;
-  std::unique_ptr<Hardware> hardware_;
-  std::unique_ptr<RecordingTap> tap_;
   std::unique_ptr<MessageSink> lcm_sink_;
-  std::unique_ptr<runtime::RecordingSink> recording_sink_;
+  std::unique_ptr<TickPipeline> pipeline_;
+  QueuedOutput queued_output_{*this};
   hal::MonotonicClock clock_;
   // Snapshots are large: a few slots cover the publisher thread waking late.
   SpscRing<PublishJob> publish_jobs_{8};
@@ -88,7 +93,8 @@ class Runtime {
   std::atomic<bool> steady_{false};
   std::atomic<bool> rt_failed_{false};
   std::string rt_warnings_;
-  std::thread loop_, pub_, lcmin_, imu_;
+  std::thread loop_, pub_, lcmin_;
+  std::thread devices_[kMaxThreadDevices];
 };
 
 }  // namespace rtfuse

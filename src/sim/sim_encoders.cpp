@@ -7,7 +7,7 @@ namespace rtfuse::sim {
 
 namespace {
 constexpr double kTwoPi = 6.283185307179586476925;
-namespace canopen = hal::mock::canopen;
+namespace canopen = sim::canopen;
 }  // namespace
 
 std::int64_t wheel_counts(const RobotBody& robot, const TruthState& truth, int wheel) noexcept {
@@ -36,12 +36,12 @@ SimEncoders::SimEncoders(const DriveScenario& scenario, const TruthTrajectory& t
       wheel_count_(std::clamp(scenario.robot.wheel_count, 0, kMaxSimWheels)),
       bus_(hal::mock::MockCanBusCapacity{}, &clock) {
   for (int w = 0; w < wheel_count_; ++w) {
-    hal::mock::CanopenEncoderConfig c;
+    sim::CanopenEncoderConfig c;
     c.node_id = robot_.wheels[static_cast<std::size_t>(w)].node_id;
     c.heartbeat_period_ns = robot_.heartbeat_period_ns;
     c.position_width = static_cast<std::uint8_t>((robot_.encoder_bits + 7) / 8);
     c.position_signed = robot_.encoder_signed;
-    nodes_[w] = std::make_unique<hal::mock::CanopenEncoderNode>(c);
+    nodes_[w] = std::make_unique<sim::CanopenEncoderNode>(c);
   }
   for (int i = 0; i < scenario.dropout_count && i < kMaxDropouts; ++i) {
     const EncoderDropout& d = scenario.dropouts[static_cast<std::size_t>(i)];
@@ -71,7 +71,7 @@ void SimEncoders::update(TimeNs now) noexcept {
     // What the nodes had due before this instant goes out first, stamped when
     // it was due, so the frames stay in time order.
     for (int w = 0; w < wheel_count_; ++w) nodes_[w]->advance(e.time, bus_);
-    hal::mock::CanopenEncoderNode& node = *nodes_[e.wheel];
+    sim::CanopenEncoderNode& node = *nodes_[e.wheel];
     if (e.begins) {
       node.set_silent(true, e.time);
       continue;

@@ -17,7 +17,7 @@
 
 #include "hal/can_bus.hpp"
 #include "hal/clock.hpp"
-#include "hal/mock/canopen_node.hpp"
+#include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 #include "sim/drive_scenario.hpp"
 #include "sim/truth_trajectory.hpp"
@@ -46,7 +46,7 @@ class SimEncoders final : public hal::CanBus {
   void update(TimeNs now) noexcept;
 
   int wheel_count() const noexcept { return wheel_count_; }
-  const hal::mock::CanopenEncoderNode& node(int wheel) const noexcept { return *nodes_[wheel]; }
+  const sim::CanopenEncoderNode& node(int wheel) const noexcept { return *nodes_[wheel]; }
   // The bus for inspection (sent log, pending frames) and fault injection.
   hal::mock::MockCanBus& bus() noexcept { return bus_; }
   const hal::mock::MockCanBus& bus() const noexcept { return bus_; }
@@ -72,7 +72,7 @@ class SimEncoders final : public hal::CanBus {
   RobotBody robot_;
   int wheel_count_ = 0;
   hal::mock::MockCanBus bus_;
-  std::unique_ptr<hal::mock::CanopenEncoderNode> nodes_[kMaxSimWheels];
+  std::unique_ptr<sim::CanopenEncoderNode> nodes_[kMaxSimWheels];
   int reboots_[kMaxSimWheels] = {};
   DropoutEdge edges_[2 * kMaxDropouts];
   int edge_count_ = 0;

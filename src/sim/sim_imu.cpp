@@ -11,13 +11,13 @@ namespace rtfuse::sim {
 
 namespace {
 
-hal::mock::MpuModel chip_model(SimImuModel m) noexcept {
+sim::MpuModel chip_model(SimImuModel m) noexcept {
   switch (m) {
-    case SimImuModel::kMpu6500: return hal::mock::MpuModel::kMpu6500;
-    case SimImuModel::kMpu9250: return hal::mock::MpuModel::kMpu9250;
+    case SimImuModel::kMpu6500: return sim::MpuModel::kMpu6500;
+    case SimImuModel::kMpu9250: return sim::MpuModel::kMpu9250;
     case SimImuModel::kMpu6050: break;
   }
-  return hal::mock::MpuModel::kMpu6050;
+  return sim::MpuModel::kMpu6050;
 }
 
 // FS_SEL / AFS_SEL of a full-scale range, -1 if none matches.
@@ -71,7 +71,7 @@ ImuSample SimImu::ideal_sample(std::int64_t k) const noexcept {
   // acceleration, the lever arm's tangential (dw x p) and centripetal
   // (w x (w x p)) parts, and the floor pushing up against gravity.
   const double f[3] = {s.accel_body[0] - dw * py - w * w * px, s.accel_body[1] + dw * px - w * w * py,
-                       s.accel_body[2] + hal::mock::mpu::kStandardGravity};
+                       s.accel_body[2] + sim::mpu::kStandardGravity};
   const double rate[3] = {0.0, 0.0, w};
   ImuSample out;
   for (int i = 0; i < 3; ++i) {  // IMU axes: the transpose of base_link <- IMU

@@ -25,7 +25,7 @@
 #include "hal/gpio.hpp"
 #include "hal/i2c_bus.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "sim/drive_scenario.hpp"
 #include "sim/truth_trajectory.hpp"
 
@@ -67,8 +67,8 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource {
   // scenario's rate whatever the driver wrote, so a mismatch is worth a log line.
   const char* config_mismatch() const noexcept;
 
-  hal::mock::MpuRegisterFile& chip() noexcept { return chip_; }
-  const hal::mock::MpuRegisterFile& chip() const noexcept { return chip_; }
+  sim::MpuRegisterFile& chip() noexcept { return chip_; }
+  const sim::MpuRegisterFile& chip() const noexcept { return chip_; }
   hal::mock::MockI2cBus& bus() noexcept { return bus_; }
 
   // --- hal::I2cBus --------------------------------------------------------------
@@ -95,7 +95,7 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource {
   double r_[3][3] = {};  // base_link <- IMU rotation of the mounting
 
   hal::mock::MockI2cBus bus_;
-  hal::mock::MpuRegisterFile chip_;
+  sim::MpuRegisterFile chip_;
   std::int64_t next_ = 0;
   std::int64_t skipped_ = 0;
   std::int64_t edges_ = 0;

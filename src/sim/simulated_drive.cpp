@@ -6,11 +6,7 @@
 #include <thread>
 
 #include "hal/mock/sim_clock.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/hal_replay.hpp"
-#include "runtime/hardware.hpp"
-#include "runtime/publisher.hpp"
-#include "runtime/recording_tap.hpp"
+#include "runtime/tick_pipeline.hpp"
 #include "sim/ground_truth.hpp"
 #include "sim/simulated_robot.hpp"
 
@@ -38,36 +34,20 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
     result.error = error;
     return result;
   }
-  std::unique_ptr<FusionCore> core = FusionCore::create(cfg, &error);
-  if (!core) {
-    result.error = error;
-    return result;
-  }
-  HalBuses buses = robot->buses();
-  std::unique_ptr<RecordingTap> tap;
-  if (!options.record_path.empty()) {
-    tap = RecordingTap::create(options.record_path, core->config(), options.config_text, buses, clock, t0, &error);
-    if (!tap || !tap->recorder().start(&error)) {
-      result.error = error;
-      return result;
-    }
-    buses = tap->buses();
-  }
-  std::unique_ptr<Hardware> hardware = Hardware::create(buses, *core, &error);
-  if (!hardware) {
-    result.error = error;
-    return result;
-  }
-  core->set_devices(hardware.get());
-  Publisher publisher(core->config());
   NullSink null_sink;
-  std::unique_ptr<runtime::RecordingSink> recording;
-  if (tap) recording = std::make_unique<runtime::RecordingSink>(null_sink, tap->recorder());
-  MessageSink& sink = recording ? static_cast<MessageSink&>(*recording) : null_sink;
-  if (!hardware->start(t0, &error)) {
+  PipelineOptions pipeline_options;
+  pipeline_options.record_path = options.record_path;
+  pipeline_options.config_text = options.config_text;
+  pipeline_options.record_clock = &clock;
+  pipeline_options.start_ns = t0;
+  pipeline_options.sink = &null_sink;
+  std::unique_ptr<TickPipeline> pipeline = TickPipeline::create(cfg, robot->buses(), pipeline_options, &error);
+  if (!pipeline || !pipeline->start(t0, &error)) {
     result.error = error;
     return result;
   }
+  RecordingTap* tap = pipeline->tap();
+  DirectOutput output(pipeline->publisher(), pipeline->sink());
 
   const TimeNs period = static_cast<TimeNs>(std::llround(1e9 / cfg.rate_hz));
   const TimeNs truth_period = static_cast<TimeNs>(std::llround(1e9 / options.truth_rate_hz));
@@ -86,20 +66,17 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
     // Let the writer catch up: in lockstep nothing may be lost.
     while (tap && tap->recorder().backlogged()) std::this_thread::sleep_for(std::chrono::microseconds(200));
     clock.set(t);
-    // The IMU thread's edges up to this tick, as it would have read them
-    // before the loop woke.
-    if (hardware->has_imu()) {
-      // Bounded: a driver that is down (re-init backing off) does not wait
-      // for edges, and the edge time would not move.
-      for (int k = 0; k < 64 && robot->imu().next_edge_time() <= t; ++k) hardware->imu_step(kImuEdgeTimeoutNs);
+    // Each device thread's events up to this tick, as it would have handled
+    // them before the loop woke. Bounded: a driver that is down (re-init
+    // backing off) does not wait, and the event time would not move.
+    for (int d = 0; d < pipeline->thread_device_count(); ++d) {
+      ThreadDevice& device = pipeline->thread_device(d);
+      for (int k = 0; k < 64 && robot->next_event_time(device.name()) <= t; ++k) device.step(kDeviceStepTimeoutNs);
       clock.set(t);
     }
     ++loop.ticks;
-    core->tick(t, loop);
-    const Snapshot& snap = core->last_snapshot();
-    const std::uint32_t due = publisher.schedule(snap, t);
-    if (tap) tap->recorder().record_tick(t, snap.seq, core->consumed(), core->config().num_sensors, due);
-    publisher.publish(snap, due, t, sink);
+    pipeline->step(t, loop, output);
+    const Snapshot& snap = pipeline->core().last_snapshot();
     const TruthState truth = robot->truth_at(t);
     if (t >= next_truth) {
       next_truth += truth_period;
@@ -129,10 +106,10 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
   result.duration_s = duration;
   result.rms_error_m = samples > 0 ? std::sqrt(sum_sq / static_cast<double>(samples)) : 0.0;
   result.raw_rms_error_m = raw_samples > 0 ? std::sqrt(raw_sum_sq / static_cast<double>(raw_samples)) : 0.0;
-  core->snapshot().load(result.final);
+  pipeline->core().snapshot().load(result.final);
   if (tap) {
     result.recording_lost = tap->overflows();
-    if (!tap->recorder().stop(&error)) {
+    if (!pipeline->stop(&error)) {
       result.error = "writing the recording: " + error;
       return result;
     }

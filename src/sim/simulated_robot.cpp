@@ -1,5 +1,7 @@
 #include "sim/simulated_robot.hpp"
 
+#include <limits>
+
 #include "sim/ground_truth.hpp"
 #include "transport/encode_buffer.hpp"
 
@@ -25,7 +27,7 @@ std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg,
   if (hw.can.enabled) {
     for (int i = 0; i < hw.can.num_nodes; ++i) {
       const int id = hw.can.nodes[static_cast<std::size_t>(i)].node_id;
-      const WheelNodeConfig& n = hw.can.nodes[static_cast<std::size_t>(i)];
+      const CanNodeSection& n = hw.can.nodes[static_cast<std::size_t>(i)];
       bool found = false;
       for (int w = 0; w < body.wheel_count; ++w) {
         const SimWheel& wheel = body.wheels[static_cast<std::size_t>(w)];
@@ -75,9 +77,9 @@ std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg,
 HalBuses SimulatedRobot::buses() {
   HalBuses b;
   b.can = encoders_.get();
-  b.i2c = imu_.get();
-  b.drdy = imu_.get();
-  b.imu_clock = clock_;
+  b.imu.i2c = imu_.get();
+  b.imu.data_ready = imu_.get();
+  b.imu.clock = clock_;
   return b;
 }
 
@@ -95,6 +97,11 @@ const std::uint8_t* GroundTruthEncoder::encode(const TruthState& truth, TimeNs s
   fill_ground_truth(truth, stamp, seq_++, &msg_);
   *size = transport::encode_into(msg_, buf_.data(), static_cast<int>(buf_.size()));
   return buf_.data();
+}
+
+TimeNs SimulatedRobot::next_event_time(std::string_view name) const noexcept {
+  if (name == "imu" && imu_) return imu_->next_edge_time();
+  return std::numeric_limits<TimeNs>::max();
 }
 
 }  // namespace rtfuse::sim

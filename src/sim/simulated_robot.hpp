@@ -40,6 +40,11 @@ class SimulatedRobot {
   // The drive's length (scenario duration, or the path's).
   double duration_s() const;
   TruthState truth_at(TimeNs t) const noexcept;
+  // When the simulated device behind the thread device `name` ("imu") next
+  // has something for its driver (a data-ready edge); far in the future for
+  // a device this robot does not simulate. The lockstep drive steps each
+  // thread device up to the tick with it.
+  TimeNs next_event_time(std::string_view name) const noexcept;
 
  private:
   SimulatedRobot() = default;

@@ -555,7 +555,7 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
 
   HalRecordCodec codec(rec.info.devices);
   for (const std::string& name : rec.info.streams) {
-    rec.streams.push_back(std::make_unique<hal::mock::ReplayStream>(name));
+    rec.streams.push_back(std::make_unique<hal::replay::ReplayStream>(name));
   }
   for (std::size_t i = 0; i < rec.info.devices.size(); ++i) {
     const RecordedDevice& d = rec.info.devices[i];

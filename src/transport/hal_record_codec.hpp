@@ -22,7 +22,7 @@
 
 #include "core/time.hpp"
 #include "hal/bus_event.hpp"
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 #include "transport/event_log.hpp"
 
 namespace rtfuse::transport {
@@ -128,7 +128,7 @@ struct RecordedOutput {
 struct HalRecording {
   RecordingInfo info;
   // One per info.streams entry, in that order, with every device's name set.
-  std::vector<std::unique_ptr<hal::mock::ReplayStream>> streams;
+  std::vector<std::unique_ptr<hal::replay::ReplayStream>> streams;
   std::vector<LoopTick> ticks;
   std::vector<RecordedOutput> outputs;
   std::int64_t events = 0;         // log events loaded

@@ -117,7 +117,7 @@ void BM_HardwareTick(benchmark::State& state) {
     state.SkipWithError(("Hardware::start: " + error).c_str());
     return;
   }
-  if (!hw->has_imu()) {
+  if (hw->imu() == nullptr) {
     state.SkipWithError("config/sim.toml runs no IMU driver: the benchmark would measure the encoders only");
     return;
   }
@@ -132,7 +132,7 @@ void BM_HardwareTick(benchmark::State& state) {
   auto one_period = [&]() {
     t += kPeriodNs;
     clock.set(t);
-    for (int k = 0; k < 64 && robot->imu().next_edge_time() <= t; ++k) hw->imu_step(rtfuse::kImuEdgeTimeoutNs);
+    for (int k = 0; k < 64 && robot->imu().next_edge_time() <= t; ++k) hw->imu()->step_imu(rtfuse::kDeviceStepTimeoutNs);
     clock.set(t);
     ++loop.ticks;
     core->tick(t, loop);
@@ -140,7 +140,7 @@ void BM_HardwareTick(benchmark::State& state) {
   for (int i = 0; i < kWarmupTicks; ++i) one_period();
 
   const rtfuse::Snapshot s0 = core->last_snapshot();
-  const std::int64_t imu0 = hw->imu_samples();
+  const std::int64_t imu0 = hw->imu()->samples();
   // Per-iteration durations, sized before the timed loop.
   std::vector<std::int64_t> durations(static_cast<std::size_t>(state.max_iterations), 0);
   std::size_t n = 0;
@@ -179,7 +179,7 @@ void BM_HardwareTick(benchmark::State& state) {
   const double iters = static_cast<double>(state.iterations());
   state.counters["wheel_per_iter"] = static_cast<double>(wheels) / iters;
   state.counters["imu_per_iter"] = static_cast<double>(imu) / iters;
-  const std::int64_t imu_read = hw->imu_samples() - imu0;
+  const std::int64_t imu_read = hw->imu()->samples() - imu0;
   if (!s1.initialized) {
     state.SkipWithError("the filter never initialised");
   } else if (wheels < state.iterations() * 9 / 10 || imu < state.iterations() / 5 * 9 / 10 ||

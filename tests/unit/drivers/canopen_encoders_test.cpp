@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "hal/mock/canopen_node.hpp"
+#include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 
 namespace {
@@ -21,10 +21,10 @@ using rtfuse::drivers::EncoderHealth;
 using rtfuse::drivers::EncoderSampleSet;
 using rtfuse::hal::CanFrame;
 using rtfuse::hal::HalStatus;
-using rtfuse::hal::mock::CanopenEncoderConfig;
-using rtfuse::hal::mock::CanopenEncoderNode;
+using rtfuse::sim::CanopenEncoderConfig;
+using rtfuse::sim::CanopenEncoderNode;
 using rtfuse::hal::mock::MockCanBus;
-using NmtState = rtfuse::hal::mock::canopen::NmtState;
+using NmtState = rtfuse::sim::canopen::NmtState;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kPeriod = 5 * kMs;  // a 200 Hz loop

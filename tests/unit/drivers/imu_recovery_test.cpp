@@ -7,7 +7,7 @@
 
 #include "drivers/imu/mpu_imu.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/scripted_gpio.hpp"
 #include "hal/mock/sim_clock.hpp"
 
@@ -20,10 +20,10 @@ using rtfuse::drivers::MpuImuConfig;
 using rtfuse::drivers::StepResult;
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::hal::mock::MpuRegisterFile;
+using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::ScriptedEdgeSource;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::hal::mock::MpuModel;
+using Chip = rtfuse::sim::MpuModel;
 
 constexpr double kG = 9.80665;
 constexpr TimeNs kMs = 1'000'000;

@@ -6,7 +6,7 @@
 
 #include "drivers/imu/mpu_driver.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -19,9 +19,9 @@ using rtfuse::drivers::MpuSaturation;
 using rtfuse::drivers::ReadStatus;
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::hal::mock::MpuRegisterFile;
+using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::hal::mock::MpuModel;
+using Chip = rtfuse::sim::MpuModel;
 
 constexpr double kG = 9.80665;
 

@@ -7,7 +7,7 @@
 
 #include "drivers/imu/mpu_driver.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/sim_clock.hpp"
 
 namespace {
@@ -17,9 +17,9 @@ using rtfuse::drivers::MpuConfig;
 using rtfuse::drivers::MpuDriver;
 using rtfuse::drivers::ReadStatus;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::hal::mock::MpuRegisterFile;
+using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::hal::mock::MpuModel;
+using Chip = rtfuse::sim::MpuModel;
 using Model = rtfuse::drivers::MpuModel;
 using Eigen::Vector3d;
 

@@ -9,7 +9,7 @@
 #include <string>
 
 #include "drivers/canopen/canopen_encoders.hpp"
-#include "hal/mock/canopen_node.hpp"
+#include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -448,8 +448,8 @@ TEST(PlanarPose, ArcMatchesTheCircleForAnyTurn) {
 }
 
 TEST(WheelOdometry, FromCanopenNodesToAPose) {
-  using rtfuse::hal::mock::CanopenEncoderConfig;
-  using rtfuse::hal::mock::CanopenEncoderNode;
+  using rtfuse::sim::CanopenEncoderConfig;
+  using rtfuse::sim::CanopenEncoderNode;
   using rtfuse::hal::mock::MockCanBus;
   MockCanBus bus;
   CanopenEncoderConfig lc;

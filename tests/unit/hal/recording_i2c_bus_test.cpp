@@ -3,7 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -15,10 +15,10 @@ using rtfuse::hal::BusEventKind;
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::RecordingI2cBus;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::hal::mock::MpuModel;
-using rtfuse::hal::mock::MpuRegisterFile;
+using rtfuse::sim::MpuModel;
+using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::SimClock;
-namespace mpu = rtfuse::hal::mock::mpu;
+namespace mpu = rtfuse::sim::mpu;
 
 constexpr std::uint8_t kAddr = 0x68;
 

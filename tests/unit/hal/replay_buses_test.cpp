@@ -6,11 +6,11 @@
 
 #include "hal/mock/mock_can_bus.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
-#include "hal/mock/replay_can_bus.hpp"
-#include "hal/mock/replay_clock.hpp"
-#include "hal/mock/replay_gpio.hpp"
-#include "hal/mock/replay_i2c_bus.hpp"
+#include "sim/devices/mpu_register_file.hpp"
+#include "hal/replay/replay_can_bus.hpp"
+#include "hal/replay/replay_clock.hpp"
+#include "hal/replay/replay_gpio.hpp"
+#include "hal/replay/replay_i2c_bus.hpp"
 #include "hal/mock/scripted_gpio.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "hal/recording_can_bus.hpp"
@@ -31,6 +31,7 @@ using hal::GpioEdgeSource;
 using hal::HalStatus;
 using hal::I2cBus;
 namespace mock = hal::mock;
+namespace replay = hal::replay;
 
 // What a driver saw from one call, to compare recording with replay.
 struct Seen {
@@ -89,7 +90,7 @@ TEST(HalReplayBuses, ReplayReturnsWhatTheRecordedBusesReturned) {
   // --- record
   mock::SimClock sim(1'000'000'000);
   mock::MockCanBus can({}, &sim);
-  mock::MpuRegisterFile chip(mock::MpuModel::kMpu6050);
+  sim::MpuRegisterFile chip(sim::MpuModel::kMpu6050);
   mock::MockI2cBus i2c;
   ASSERT_TRUE(i2c.attach(0x68, chip));
   ASSERT_EQ(i2c.write_register(0x68, 0x6B, 0x01), HalStatus::kOk);
@@ -112,15 +113,15 @@ TEST(HalReplayBuses, ReplayReturnsWhatTheRecordedBusesReturned) {
   const std::vector<Seen> live = run_script(rcan, ri2c, rdrdy, rclock);
 
   // --- replay
-  mock::ReplayStream stream("loop");
+  replay::ReplayStream stream("loop");
   BusEvent ev;
   std::int64_t n = 0;
   while (loop_ring.try_pop(ev)) stream.append(ev, 100 + n++);
   EXPECT_EQ(stream.size(), 30u);  // 5 ticks x (send, receive, edge, read, now, sleep)
-  mock::ReplayCanBus pcan(stream, 0);
-  mock::ReplayI2cBus pi2c(stream, 1);
-  mock::ReplayEdgeSource pdrdy(stream, 2);
-  mock::ReplayClock pclock(stream, 3);
+  replay::ReplayCanBus pcan(stream, 0);
+  replay::ReplayI2cBus pi2c(stream, 1);
+  replay::ReplayEdgeSource pdrdy(stream, 2);
+  replay::ReplayClock pclock(stream, 3);
   const std::vector<Seen> replayed = run_script(pcan, pi2c, pdrdy, pclock);
 
   EXPECT_FALSE(stream.diverged()) << stream.divergence();

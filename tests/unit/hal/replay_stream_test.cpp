@@ -1,13 +1,13 @@
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 
-#include "hal/mock/replay_can_bus.hpp"
-#include "hal/mock/replay_clock.hpp"
-#include "hal/mock/replay_gpio.hpp"
-#include "hal/mock/replay_i2c_bus.hpp"
+#include "hal/replay/replay_can_bus.hpp"
+#include "hal/replay/replay_clock.hpp"
+#include "hal/replay/replay_gpio.hpp"
+#include "hal/replay/replay_i2c_bus.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace {
@@ -17,13 +17,13 @@ using rtfuse::hal::BusEventKind;
 using rtfuse::hal::CanFrame;
 using rtfuse::hal::GpioEdge;
 using rtfuse::hal::HalStatus;
-using rtfuse::hal::mock::DivergenceKind;
-using rtfuse::hal::mock::ReplayCanBus;
-using rtfuse::hal::mock::ReplayClock;
-using rtfuse::hal::mock::ReplayEdgeSource;
-using rtfuse::hal::mock::ReplayGpioOutput;
-using rtfuse::hal::mock::ReplayI2cBus;
-using rtfuse::hal::mock::ReplayStream;
+using rtfuse::hal::replay::DivergenceKind;
+using rtfuse::hal::replay::ReplayCanBus;
+using rtfuse::hal::replay::ReplayClock;
+using rtfuse::hal::replay::ReplayEdgeSource;
+using rtfuse::hal::replay::ReplayGpioOutput;
+using rtfuse::hal::replay::ReplayI2cBus;
+using rtfuse::hal::replay::ReplayStream;
 
 BusEvent can_send(std::uint8_t device, std::uint32_t id, std::uint8_t dlc, const std::uint8_t* data = nullptr) {
   BusEvent ev;

@@ -12,10 +12,10 @@
 
 #include <gtest/gtest.h>
 
-#include "hal/mock/canopen_node.hpp"
+#include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/scripted_gpio.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "runtime/config_loader.hpp"
@@ -25,12 +25,12 @@
 namespace rtfuse {
 namespace {
 
-using hal::mock::CanopenEncoderConfig;
-using hal::mock::CanopenEncoderNode;
+using sim::CanopenEncoderConfig;
+using sim::CanopenEncoderNode;
 using hal::mock::MockCanBus;
 using hal::mock::MockCanBusCapacity;
 using hal::mock::MockI2cBus;
-using hal::mock::MpuRegisterFile;
+using sim::MpuRegisterFile;
 using hal::mock::ScriptedEdgeSource;
 using hal::mock::SimClock;
 
@@ -377,7 +377,7 @@ TEST(Hardware, SteadyStateTicksAllocateNothing) {
 // An MPU-6050 on a mock I2C bus with a scripted data-ready line; the IMU
 // thread's steps are interleaved with the loop's ticks.
 struct ImuRig {
-  explicit ImuRig(const std::string& text) : chip(hal::mock::MpuModel::kMpu6050), edges(256, &clock) {
+  explicit ImuRig(const std::string& text) : chip(sim::MpuModel::kMpu6050), edges(256, &clock) {
     EXPECT_TRUE(i2c.attach(0x68, chip));
     std::string err;
     core = FusionCore::create(load(text), &err);
@@ -385,9 +385,9 @@ struct ImuRig {
   }
   bool start() {
     HalBuses buses;
-    buses.i2c = &i2c;
-    buses.drdy = &edges;
-    buses.imu_clock = &clock;
+    buses.imu.i2c = &i2c;
+    buses.imu.data_ready = &edges;
+    buses.imu.clock = &clock;
     hardware = Hardware::create(buses, *core, &error);
     if (!hardware) return false;
     core->set_devices(hardware.get());
@@ -405,11 +405,11 @@ struct ImuRig {
     ++n;
     // A small varying x so consecutive samples are never identical (the
     // driver calls a chip that repeats itself frozen).
-    const double accel[3] = {2e-3 * (n % 7), 0.0, hal::mock::mpu::kStandardGravity};
+    const double accel[3] = {2e-3 * (n % 7), 0.0, sim::mpu::kStandardGravity};
     const double gyro[3] = {0.0, 0.0, yaw_rate};
     if (!chip.set_sample(accel, gyro, 25.0)) ++chip_refused;
     edges.push(t);
-    const drivers::StepResult r = hardware->imu_step(kImuEdgeTimeoutNs);
+    const drivers::StepResult r = hardware->imu()->step_imu(kDeviceStepTimeoutNs);
     clock.set(t);
     ++loop.ticks;
     core->tick(t, loop);
@@ -438,13 +438,13 @@ TEST(Hardware, ImuYawRateReachesTheEstimate) {
   ImuRig rig(std::string(kFilter) + kMpu + kImuMount);
   ASSERT_TRUE(rig.core);
   ASSERT_TRUE(rig.start()) << rig.error;
-  ASSERT_TRUE(rig.hardware->has_imu());
+  ASSERT_TRUE(rig.hardware->imu() != nullptr);
   constexpr double kRate = 0.5;  // rad/s, above the standstill threshold
   int samples = 0;
   for (int i = 0; i < 400; ++i) samples += rig.step(kRate) == drivers::StepResult::kSample;
   EXPECT_EQ(rig.chip_refused, 0) << "data-ready was not enabled by the driver";
   EXPECT_EQ(samples, 400);
-  EXPECT_EQ(rig.hardware->imu_samples(), 400);
+  EXPECT_EQ(rig.hardware->imu()->samples(), 400);
   const Snapshot& s = rig.snap();
   ASSERT_TRUE(s.initialized);
   EXPECT_TRUE(all_finite(s));

@@ -12,7 +12,7 @@
 #include <vector>
 
 #include "hal/mock/mock_can_bus.hpp"
-#include "hal/mock/replay_can_bus.hpp"
+#include "hal/replay/replay_can_bus.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "hal/recording_can_bus.hpp"
 #include "support/alloc_counter.hpp"
@@ -205,7 +205,7 @@ TEST(Recorder, DecoratorsRecordAndTheRecordingReplays) {
 
   HalRecording loaded;
   ASSERT_TRUE(load(log.path(), &loaded, &err)) << err;
-  hal::mock::ReplayCanBus replay(*loaded.streams[0], 0);
+  hal::replay::ReplayCanBus replay(*loaded.streams[0], 0);
   EXPECT_EQ(replay.send(sync), HalStatus::kOk);
   ASSERT_EQ(replay.receive(out, 4, 0, &st), 1);
   EXPECT_EQ(out[0].id, 0x181u);
@@ -271,7 +271,7 @@ TEST(Recorder, ALostEventShowsAsAHoleInTheLoadedStream) {
   ASSERT_TRUE(load(log.path(), &loaded, &err)) << err;
   EXPECT_EQ(loaded.streams[0]->size(), 2u);
   EXPECT_EQ(loaded.lost_events, 1);
-  hal::mock::ReplayCanBus replay(*loaded.streams[0], 0);
+  hal::replay::ReplayCanBus replay(*loaded.streams[0], 0);
   EXPECT_EQ(replay.send(f), HalStatus::kOk);
   EXPECT_EQ(replay.send(f), HalStatus::kOk);
   EXPECT_EQ(replay.send(f), HalStatus::kClosed);

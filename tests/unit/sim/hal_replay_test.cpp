@@ -28,7 +28,7 @@ namespace {
 
 using hal::BusEvent;
 using hal::BusEventKind;
-using hal::mock::ReplayStream;
+using hal::replay::ReplayStream;
 
 const std::string kSimToml = RTFUSE_SOURCE_DIR "/config/sim.toml";
 const std::string kStraight = RTFUSE_SOURCE_DIR "/config/scenarios/straight.toml";

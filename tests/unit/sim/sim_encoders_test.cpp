@@ -16,7 +16,7 @@ namespace {
 using hal::CanFrame;
 using hal::HalStatus;
 using hal::mock::SimClock;
-using NmtState = hal::mock::canopen::NmtState;
+using NmtState = sim::canopen::NmtState;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kSec = 1'000 * kMs;

@@ -19,7 +19,7 @@ namespace {
 using hal::GpioEdge;
 using hal::HalStatus;
 using hal::mock::SimClock;
-namespace mpu = hal::mock::mpu;
+namespace mpu = sim::mpu;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kSec = 1'000 * kMs;
@@ -68,7 +68,7 @@ struct Decoded {
   std::uint8_t bytes[14];
 };
 
-Decoded burst_read(SimImu& imu, hal::mock::MpuModel model = hal::mock::MpuModel::kMpu6050) {
+Decoded burst_read(SimImu& imu, sim::MpuModel model = sim::MpuModel::kMpu6050) {
   Decoded d{};
   EXPECT_EQ(imu.read_registers(0x68, mpu::kAccelXoutH, d.bytes, 14), HalStatus::kOk);
   auto be16 = [&](int i) { return static_cast<std::int16_t>((d.bytes[i] << 8) | d.bytes[i + 1]); };

@@ -1,8 +1,8 @@
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 
 #include <cmath>
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::sim {
 
 namespace mpu {
 
@@ -128,12 +128,12 @@ bool MpuRegisterFile::set_sample(const double accel_mps2[3], const double gyro_r
   return set_raw_sample(a, t, g);
 }
 
-HalStatus MpuRegisterFile::i2c_read(std::uint8_t reg, std::uint8_t* buf, int n) noexcept {
+hal::HalStatus MpuRegisterFile::i2c_read(std::uint8_t reg, std::uint8_t* buf, int n) noexcept {
   if (nack_remaining_ > 0) {
     --nack_remaining_;
-    return HalStatus::kNack;
+    return hal::HalStatus::kNack;
   }
-  if (buf == nullptr || n < 1) return HalStatus::kIoError;
+  if (buf == nullptr || n < 1) return hal::HalStatus::kIoError;
   bool read_status = false;
   for (int i = 0; i < n; ++i) {
     const auto r = static_cast<std::uint8_t>(reg + i);
@@ -141,21 +141,21 @@ HalStatus MpuRegisterFile::i2c_read(std::uint8_t reg, std::uint8_t* buf, int n) 
     read_status = read_status || r == mpu::kIntStatus;
   }
   if (read_status || (regs_[mpu::kIntPinCfg] & mpu::kIntRdClear) != 0) regs_[mpu::kIntStatus] = 0;
-  return HalStatus::kOk;
+  return hal::HalStatus::kOk;
 }
 
-HalStatus MpuRegisterFile::i2c_write(std::uint8_t reg, std::uint8_t value) noexcept {
+hal::HalStatus MpuRegisterFile::i2c_write(std::uint8_t reg, std::uint8_t value) noexcept {
   if (nack_remaining_ > 0) {
     --nack_remaining_;
-    return HalStatus::kNack;
+    return hal::HalStatus::kNack;
   }
   if (reg == mpu::kPwrMgmt1 && (value & mpu::kPwrDeviceReset) != 0) {
     reset_registers();
     ++reset_count_;
-    return HalStatus::kOk;
+    return hal::HalStatus::kOk;
   }
   if (!read_only(reg)) regs_[reg] = value;
-  return HalStatus::kOk;
+  return hal::HalStatus::kOk;
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::sim

@@ -7,9 +7,9 @@
 #include <cstdint>
 
 #include "hal/i2c_bus.hpp"
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 class ReplayI2cBus final : public I2cBus {
  public:
@@ -31,4 +31,4 @@ class ReplayI2cBus final : public I2cBus {
   HalStatus last_status_ = HalStatus::kOk;
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

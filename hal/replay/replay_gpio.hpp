@@ -6,9 +6,9 @@
 #include <cstdint>
 
 #include "hal/gpio.hpp"
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 class ReplayEdgeSource final : public GpioEdgeSource {
  public:
@@ -40,4 +40,4 @@ class ReplayGpioOutput final : public GpioOutput {
   bool level_ = false;
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

@@ -1,4 +1,4 @@
-#include "sim/sim_robot.hpp"
+#include "sim/lcm_sim_robot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -167,8 +167,8 @@ enum StreamId { kImu = 0, kOdom, kTruth, kStreams };
 
 }  // namespace
 
-struct SimRobot::Impl {
-  Impl(const SimConfig& c, TimeNs t0)
+struct LcmSimRobot::Impl {
+  Impl(const LcmSimConfig& c, TimeNs t0)
       : cfg(c),
         start(t0),
         path(c.figure_eight_radius_m, c.speed_mps),
@@ -196,8 +196,8 @@ struct SimRobot::Impl {
 
   // What the encoders report through the differential-drive kinematics when
   // each wheel's ground speed is off by its own slip fraction.
-  SimRobotSlip slip_at(double t, const Kinematics& k) const noexcept {
-    SimRobotSlip w{};
+  LcmSimRobotSlip slip_at(double t, const Kinematics& k) const noexcept {
+    LcmSimRobotSlip w{};
     w.left = wheel_slip_at(t, 0);
     w.right = wheel_slip_at(t, 1);
     const double v_left = k.v - 0.5 * kTrackWidth * k.yaw_rate;
@@ -211,7 +211,7 @@ struct SimRobot::Impl {
   void build_odom(TimeNs stamp) noexcept;
   void build_truth(TimeNs stamp) noexcept;
 
-  SimConfig cfg;  // owns the channel strings handed out in SimMessage
+  LcmSimConfig cfg;  // owns the channel strings handed out in SimMessage
   TimeNs start;
   FigureEight path;
   Gaussian imu_noise;
@@ -230,7 +230,7 @@ struct SimRobot::Impl {
   double odom_x = 0.0, odom_y = 0.0, odom_yaw = 0.0;
 };
 
-void SimRobot::Impl::build_imu(TimeNs stamp) noexcept {
+void LcmSimRobot::Impl::build_imu(TimeNs stamp) noexcept {
   const double t = seconds(stamp);
   const Kinematics k = path.at(t);
   auto& m = imu.msg;
@@ -262,10 +262,10 @@ void SimRobot::Impl::build_imu(TimeNs stamp) noexcept {
   m.linear_acceleration.z = kGravity + biases.accel[2] + sa * imu_noise();
 }
 
-void SimRobot::Impl::build_odom(TimeNs stamp) noexcept {
+void LcmSimRobot::Impl::build_odom(TimeNs stamp) noexcept {
   const double t = seconds(stamp);
   const Kinematics k = path.at(t);
-  const SimRobotSlip slip = slip_at(t, k);
+  const LcmSimRobotSlip slip = slip_at(t, k);
   const double vx = k.v * (1.0 + slip.speed_fraction) + cfg.odom_speed_noise_mps * odom_noise();
   const double vyaw = k.yaw_rate + slip.yaw_rate_error + cfg.odom_yaw_rate_noise_rad_s * odom_noise();
 
@@ -291,7 +291,7 @@ void SimRobot::Impl::build_odom(TimeNs stamp) noexcept {
   m.twist.twist.angular.z = vyaw;
 }
 
-void SimRobot::Impl::build_truth(TimeNs stamp) noexcept {
+void LcmSimRobot::Impl::build_truth(TimeNs stamp) noexcept {
   const Kinematics k = path.at(seconds(stamp));
   auto& m = truth.msg;
   m.header.utime = ns_to_utime(stamp);
@@ -303,7 +303,7 @@ void SimRobot::Impl::build_truth(TimeNs stamp) noexcept {
   m.twist.twist.angular.z = k.yaw_rate;
 }
 
-SimRobot::SimRobot(const SimConfig& cfg, TimeNs start) : impl_(std::make_unique<Impl>(cfg, start)) {
+LcmSimRobot::LcmSimRobot(const LcmSimConfig& cfg, TimeNs start) : impl_(std::make_unique<Impl>(cfg, start)) {
   Impl& m = *impl_;
 
   m.imu.msg.header.frame_id = "base_link";
@@ -336,15 +336,15 @@ SimRobot::SimRobot(const SimConfig& cfg, TimeNs start) : impl_(std::make_unique<
   m.truth.finalize();
 }
 
-SimRobot::~SimRobot() = default;
+LcmSimRobot::~LcmSimRobot() = default;
 
-TimeNs SimRobot::next_time() const noexcept {
+TimeNs LcmSimRobot::next_time() const noexcept {
   TimeNs t = kNever;
   for (const auto& s : impl_->streams) t = std::min(t, s.time());
   return t;
 }
 
-bool SimRobot::next_due(TimeNs now, SimMessage* out) noexcept {
+bool LcmSimRobot::next_due(TimeNs now, SimMessage* out) noexcept {
   Impl& m = *impl_;
   int id = kImu;
   TimeNs stamp = m.streams[kImu].time();
@@ -386,18 +386,18 @@ bool SimRobot::next_due(TimeNs now, SimMessage* out) noexcept {
   return true;
 }
 
-TruthPose SimRobot::truth(TimeNs t) const noexcept {
+TruthPose LcmSimRobot::truth(TimeNs t) const noexcept {
   const Kinematics k = impl_->path.at(impl_->seconds(t));
   return TruthPose{k.x, k.y, k.yaw, k.v, k.yaw_rate};
 }
 
-double SimRobot::period_s() const noexcept { return impl_->path.period(); }
+double LcmSimRobot::period_s() const noexcept { return impl_->path.period(); }
 
-SimRobotSlip SimRobot::slip(TimeNs t) const noexcept {
+LcmSimRobotSlip LcmSimRobot::slip(TimeNs t) const noexcept {
   const double s = impl_->seconds(t);
   return impl_->slip_at(s, impl_->path.at(s));
 }
 
-const SimBiases& SimRobot::biases() const noexcept { return impl_->biases; }
+const SimBiases& LcmSimRobot::biases() const noexcept { return impl_->biases; }
 
 }  // namespace rtfuse::sim

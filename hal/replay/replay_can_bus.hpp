@@ -7,9 +7,9 @@
 #include <cstdint>
 
 #include "hal/can_bus.hpp"
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 class ReplayCanBus final : public CanBus {
  public:
@@ -34,4 +34,4 @@ class ReplayCanBus final : public CanBus {
   HalStatus last_status_ = HalStatus::kOk;
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

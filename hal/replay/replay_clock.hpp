@@ -8,9 +8,9 @@
 #include <cstdint>
 
 #include "hal/clock.hpp"
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 class ReplayClock final : public Clock {
  public:
@@ -25,4 +25,4 @@ class ReplayClock final : public Clock {
   mutable TimeNs last_ = 0;  // now() is const in the interface; replaying moves the cursor
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

@@ -1,6 +1,6 @@
-#include "hal/mock/replay_gpio.hpp"
+#include "hal/replay/replay_gpio.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 HalStatus ReplayEdgeSource::wait_edge(TimeNs timeout_ns, GpioEdge* out) noexcept {
   BusEvent call;
@@ -40,4 +40,4 @@ const char* ReplayGpioOutput::last_error() const noexcept {
   return stream_.diverged() ? stream_.divergence() : to_string(last_status_);
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

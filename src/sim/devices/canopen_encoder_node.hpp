@@ -1,5 +1,5 @@
 #pragma once
-// A CiA 301 / CiA 406 rotary encoder as a device on a MockCanBus, behaving
+// A CiA 301 / CiA 406 rotary encoder as a device on a hal::mock::MockCanBus, behaving
 // the way a real one does on the wire, so the encoder driver can be tested
 // (and a simulated robot driven) without hardware:
 //
@@ -25,7 +25,7 @@
 
 #include "hal/mock/mock_can_bus.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::sim {
 
 // CiA 301 constants a driver and the device model must agree on.
 namespace canopen {
@@ -62,7 +62,7 @@ struct CanopenEncoderConfig {
   std::int64_t initial_position = 0;           // counts at power-up
 };
 
-class CanopenEncoderNode final : public CanNode {
+class CanopenEncoderNode final : public hal::mock::CanNode {
  public:
   // An invalid layout (width outside 1..4, value past byte 8) is clamped to
   // the nearest valid one; valid() says whether the config was taken as is.
@@ -91,7 +91,7 @@ class CanopenEncoderNode final : public CanNode {
   void jump(std::int64_t counts) noexcept { offset_ += counts; }
   // Sends an EMCY now. False when silent, stopped or not yet booted.
   bool emit_emcy(std::uint16_t error_code, std::uint8_t error_register, const std::uint8_t manufacturer[5],
-                 TimeNs now, MockCanBus& bus) noexcept;
+                 TimeNs now, hal::mock::MockCanBus& bus) noexcept;
 
   // --- inspection -------------------------------------------------------------
   canopen::NmtState nmt_state() const noexcept { return state_; }
@@ -103,15 +103,15 @@ class CanopenEncoderNode final : public CanNode {
   const CanopenEncoderConfig& config() const noexcept { return config_; }
   bool valid() const noexcept { return valid_; }
 
-  // --- CanNode ----------------------------------------------------------------
-  void on_frame(const CanFrame& frame, TimeNs now, MockCanBus& bus) noexcept override;
-  void advance(TimeNs now, MockCanBus& bus) noexcept override;
+  // --- hal::mock::CanNode ----------------------------------------------------------------
+  void on_frame(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept override;
+  void advance(TimeNs now, hal::mock::MockCanBus& bus) noexcept override;
 
  private:
-  void boot(TimeNs now, MockCanBus& bus) noexcept;
+  void boot(TimeNs now, hal::mock::MockCanBus& bus) noexcept;
   void rebase(TimeNs now) noexcept;
-  void handle_nmt(const CanFrame& frame, TimeNs now, MockCanBus& bus) noexcept;
-  void send_tpdo(TimeNs now, MockCanBus& bus) noexcept;
+  void handle_nmt(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept;
+  void send_tpdo(TimeNs now, hal::mock::MockCanBus& bus) noexcept;
 
   CanopenEncoderConfig config_;
   bool valid_ = true;
@@ -133,4 +133,4 @@ class CanopenEncoderNode final : public CanNode {
   bool stuck_ = false;
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::sim

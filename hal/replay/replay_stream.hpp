@@ -25,7 +25,7 @@
 
 #include "hal/bus_event.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 enum class DivergenceKind : std::uint8_t {
   kNone,
@@ -109,4 +109,4 @@ class ReplayStream {
   char report_[kReportSize] = {};
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

@@ -1,4 +1,4 @@
-#include "sim/sim_robot.hpp"
+#include "sim/lcm_sim_robot.hpp"
 
 #include <gtest/gtest.h>
 
@@ -26,7 +26,7 @@ struct Captured {
   TimeNs stamp;
 };
 
-std::vector<Captured> drain(SimRobot& robot, TimeNs until) {
+std::vector<Captured> drain(LcmSimRobot& robot, TimeNs until) {
   std::vector<Captured> out;
   SimMessage m{};
   while (robot.next_due(until, &m)) out.push_back({m.channel, {m.data, m.data + m.size}, m.stamp});
@@ -58,8 +58,8 @@ struct Stats {
   double stddev() const { return std::sqrt(sum_sq / n - mean() * mean()); }
 };
 
-TEST(SimRobot, MessageRatesOverTenSeconds) {
-  SimRobot robot(SimConfig{}, kStart);
+TEST(LcmSimRobot, MessageRatesOverTenSeconds) {
+  LcmSimRobot robot(LcmSimConfig{}, kStart);
   const auto msgs = drain(robot, kStart + 10 * kSec - 1);
   int imu = 0, odom = 0, truth = 0;
   for (const auto& m : msgs) {
@@ -73,8 +73,8 @@ TEST(SimRobot, MessageRatesOverTenSeconds) {
   EXPECT_EQ(imu + odom + truth, static_cast<int>(msgs.size()));
 }
 
-TEST(SimRobot, MessagesComeInTimeOrderWithMatchingHeaders) {
-  SimRobot robot(SimConfig{}, kStart);
+TEST(LcmSimRobot, MessagesComeInTimeOrderWithMatchingHeaders) {
+  LcmSimRobot robot(LcmSimConfig{}, kStart);
   EXPECT_EQ(robot.next_time(), kStart);
   SimMessage m{};
   EXPECT_FALSE(robot.next_due(kStart - 1, &m));  // nothing before its time
@@ -105,9 +105,9 @@ TEST(SimRobot, MessagesComeInTimeOrderWithMatchingHeaders) {
   }
 }
 
-TEST(SimRobot, TruthIsAFigureEightThatClosesAfterOnePeriod) {
-  SimConfig cfg;
-  SimRobot robot(cfg, kStart);
+TEST(LcmSimRobot, TruthIsAFigureEightThatClosesAfterOnePeriod) {
+  LcmSimConfig cfg;
+  LcmSimRobot robot(cfg, kStart);
   const double period = robot.period_s();
   ASSERT_TRUE(std::isfinite(period));
 
@@ -159,9 +159,9 @@ TEST(SimRobot, TruthIsAFigureEightThatClosesAfterOnePeriod) {
   }
 }
 
-TEST(SimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
-  SimConfig cfg;
-  SimRobot robot(cfg, kStart);
+TEST(LcmSimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
+  LcmSimConfig cfg;
+  LcmSimRobot robot(cfg, kStart);
   const SimBiases& bias = robot.biases();
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(std::abs(bias.gyro[i]), cfg.gyro_bias_rad_s);
@@ -209,10 +209,10 @@ TEST(SimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
   EXPECT_LT(yaw.stddev(), std::hypot(cfg.orientation_noise_rad, cfg.yaw_error_rad));
 }
 
-TEST(SimRobot, ImuYawErrorStaysBoundedOverALongDrive) {
-  SimConfig cfg;
+TEST(LcmSimRobot, ImuYawErrorStaysBoundedOverALongDrive) {
+  LcmSimConfig cfg;
   cfg.imu_rate_hz = 20.0;  // fewer messages, same error process
-  SimRobot robot(cfg, kStart);
+  LcmSimRobot robot(cfg, kStart);
   Stats yaw;
   double worst = 0.0;
   for (const auto& c : drain(robot, kStart + 1200 * kSec)) {
@@ -228,16 +228,16 @@ TEST(SimRobot, ImuYawErrorStaysBoundedOverALongDrive) {
   EXPECT_LT(worst, 5.5 * sigma);
 }
 
-TEST(SimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
-  SimConfig cfg;
-  SimRobot robot(cfg, kStart);
+TEST(LcmSimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
+  LcmSimConfig cfg;
+  LcmSimRobot robot(cfg, kStart);
   Stats vx, vyaw;
   double slip_min = 1.0, slip_max = -1.0, yaw_error_max = 0.0, final_error = 0.0;
   for (const auto& c : drain(robot, kStart + 20 * kSec - 1)) {
     if (c.channel != "wheel/odom") continue;
     const auto odom = decode<rtfuse::odometry_t>(c);
     const TruthPose truth = robot.truth(c.stamp);
-    const SimRobotSlip s = robot.slip(c.stamp);
+    const LcmSimRobotSlip s = robot.slip(c.stamp);
     slip_min = std::min({slip_min, s.left, s.right, s.speed_fraction});
     slip_max = std::max({slip_max, s.left, s.right, s.speed_fraction});
     yaw_error_max = std::max(yaw_error_max, std::abs(s.yaw_rate_error));
@@ -268,10 +268,10 @@ TEST(SimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
   EXPECT_LT(final_error, 1.0);
 }
 
-TEST(SimRobot, SameSeedGivesIdenticalBytes) {
-  SimConfig cfg;
+TEST(LcmSimRobot, SameSeedGivesIdenticalBytes) {
+  LcmSimConfig cfg;
   cfg.seed = 42;
-  SimRobot a(cfg, kStart), b(cfg, kStart);
+  LcmSimRobot a(cfg, kStart), b(cfg, kStart);
   const auto ma = drain(a, kStart + 5 * kSec);
   // b is drained in a different rhythm: the output must not depend on it.
   std::vector<Captured> mb;
@@ -289,7 +289,7 @@ TEST(SimRobot, SameSeedGivesIdenticalBytes) {
   }
 
   cfg.seed = 43;
-  SimRobot c(cfg, kStart);
+  LcmSimRobot c(cfg, kStart);
   const auto mc = drain(c, kStart + 5 * kSec);
   ASSERT_EQ(mc.size(), ma.size());
   int differing = 0;
@@ -297,8 +297,8 @@ TEST(SimRobot, SameSeedGivesIdenticalBytes) {
   EXPECT_GT(differing, static_cast<int>(ma.size()) / 2);
 }
 
-TEST(SimRobot, NextDueNeverAllocates) {
-  SimRobot robot(SimConfig{}, kStart);
+TEST(LcmSimRobot, NextDueNeverAllocates) {
+  LcmSimRobot robot(LcmSimConfig{}, kStart);
   SimMessage m{};
   TimeNs now = kStart;
   for (; now < kStart + kSec; now += 5'000'000)

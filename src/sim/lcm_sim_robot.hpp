@@ -1,5 +1,5 @@
 #pragma once
-// The simulated robot of config/sim.toml: a figure-eight drive with ground
+// The LCM-level simulated robot of config/sim_lcm.toml: a figure-eight drive with ground
 // truth, producing the encoded LCM messages a real IMU driver and a real
 // wheel-odometry node would send (imu_t, odometry_t), plus the truth.
 //
@@ -27,7 +27,7 @@ struct TruthPose {
 };
 
 // The wheel odometry's systematic error at one instant, before white noise.
-struct SimRobotSlip {
+struct LcmSimRobotSlip {
   double left, right;     // each wheel's fractional ground-speed error, |s| <= wheel_slip
   double speed_fraction;  // resulting forward-speed error: vx = v * (1 + speed_fraction)
   double yaw_rate_error;  // resulting yaw-rate error, rad/s (added to the true rate)
@@ -40,12 +40,12 @@ struct SimBiases {
   double accel[3];  // m/s^2
 };
 
-class SimRobot {
+class LcmSimRobot {
  public:
-  SimRobot(const SimConfig& cfg, TimeNs start);
-  ~SimRobot();
-  SimRobot(const SimRobot&) = delete;
-  SimRobot& operator=(const SimRobot&) = delete;
+  LcmSimRobot(const LcmSimConfig& cfg, TimeNs start);
+  ~LcmSimRobot();
+  LcmSimRobot(const LcmSimRobot&) = delete;
+  LcmSimRobot& operator=(const LcmSimRobot&) = delete;
 
   // Stamp of the next message of any stream.
   TimeNs next_time() const noexcept;
@@ -56,7 +56,7 @@ class SimRobot {
   TruthPose truth(TimeNs t) const noexcept;
   // Time to drive the figure eight once.
   double period_s() const noexcept;
-  SimRobotSlip slip(TimeNs t) const noexcept;
+  LcmSimRobotSlip slip(TimeNs t) const noexcept;
   const SimBiases& biases() const noexcept;
 
  private:

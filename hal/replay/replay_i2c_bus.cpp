@@ -1,8 +1,8 @@
-#include "hal/mock/replay_i2c_bus.hpp"
+#include "hal/replay/replay_i2c_bus.hpp"
 
 #include <cstring>
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 const BusEvent* ReplayI2cBus::take(const BusEvent& call) noexcept {
   const BusEvent* rec = stream_.take(call);
@@ -47,4 +47,4 @@ const char* ReplayI2cBus::last_error() const noexcept {
   return stream_.diverged() ? stream_.divergence() : to_string(last_status_);
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

@@ -21,7 +21,7 @@
 
 #include "hal/mock/mock_i2c_bus.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::sim {
 
 enum class MpuModel : std::uint8_t { kMpu6050, kMpu6500, kMpu9250 };
 
@@ -59,7 +59,7 @@ double gyro_lsb_per_dps(int fs_sel) noexcept;
 double temperature_c(MpuModel model, std::int16_t raw) noexcept;
 }  // namespace mpu
 
-class MpuRegisterFile final : public I2cDevice {
+class MpuRegisterFile final : public hal::mock::I2cDevice {
  public:
   explicit MpuRegisterFile(MpuModel model) noexcept;
 
@@ -100,9 +100,9 @@ class MpuRegisterFile final : public I2cDevice {
   void set_wrong_who_am_i(std::uint8_t value) noexcept;
   void clear_faults() noexcept;
 
-  // --- I2cDevice ------------------------------------------------------------
-  HalStatus i2c_read(std::uint8_t reg, std::uint8_t* buf, int n) noexcept override;
-  HalStatus i2c_write(std::uint8_t reg, std::uint8_t value) noexcept override;
+  // --- hal::mock::I2cDevice ------------------------------------------------------------
+  hal::HalStatus i2c_read(std::uint8_t reg, std::uint8_t* buf, int n) noexcept override;
+  hal::HalStatus i2c_write(std::uint8_t reg, std::uint8_t value) noexcept override;
 
  private:
   void reset_registers() noexcept;
@@ -118,4 +118,4 @@ class MpuRegisterFile final : public I2cDevice {
   std::uint8_t who_am_i_value_ = 0;
 };
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::sim

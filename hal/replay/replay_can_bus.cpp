@@ -1,8 +1,8 @@
-#include "hal/mock/replay_can_bus.hpp"
+#include "hal/replay/replay_can_bus.hpp"
 
 #include <algorithm>
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 ReplayCanBus::ReplayCanBus(ReplayStream& stream, std::uint8_t device) noexcept
     : stream_(stream), device_(device) {
@@ -56,4 +56,4 @@ const char* ReplayCanBus::last_error() const noexcept {
   return stream_.diverged() ? stream_.divergence() : to_string(last_status_);
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

@@ -1,4 +1,4 @@
-#include "hal/mock/canopen_node.hpp"
+#include "sim/devices/canopen_encoder_node.hpp"
 
 #include <gtest/gtest.h>
 
@@ -11,10 +11,10 @@ namespace {
 using rtfuse::TimeNs;
 using rtfuse::hal::CanFrame;
 using rtfuse::hal::HalStatus;
-using rtfuse::hal::mock::CanopenEncoderConfig;
-using rtfuse::hal::mock::CanopenEncoderNode;
+using rtfuse::sim::CanopenEncoderConfig;
+using rtfuse::sim::CanopenEncoderNode;
 using rtfuse::hal::mock::MockCanBus;
-using NmtState = rtfuse::hal::mock::canopen::NmtState;
+using NmtState = rtfuse::sim::canopen::NmtState;
 
 constexpr TimeNs kMs = 1'000'000;
 

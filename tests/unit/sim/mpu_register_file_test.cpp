@@ -4,7 +4,7 @@
 #include <limits>
 
 #include "hal/mock/mock_i2c_bus.hpp"
-#include "hal/mock/mpu_register_file.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace {
@@ -13,9 +13,9 @@ using rtfuse::hal::HalStatus;
 using rtfuse::hal::I2cRetryPolicy;
 using rtfuse::hal::mock::I2cTransferRecord;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::hal::mock::MpuModel;
-using rtfuse::hal::mock::MpuRegisterFile;
-namespace mpu = rtfuse::hal::mock::mpu;
+using rtfuse::sim::MpuModel;
+using rtfuse::sim::MpuRegisterFile;
+namespace mpu = rtfuse::sim::mpu;
 
 constexpr double kG = 9.80665;
 constexpr double kDegToRad = 3.14159265358979323846 / 180.0;

@@ -1,6 +1,6 @@
-#include "hal/mock/replay_clock.hpp"
+#include "hal/replay/replay_clock.hpp"
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 
 TimeNs ReplayClock::now() const noexcept {
   BusEvent call;
@@ -19,4 +19,4 @@ void ReplayClock::sleep_until(TimeNs t) noexcept {
   stream_.take(call);
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

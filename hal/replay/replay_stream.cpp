@@ -1,4 +1,4 @@
-#include "hal/mock/replay_stream.hpp"
+#include "hal/replay/replay_stream.hpp"
 
 #include <algorithm>
 #include <cstdarg>
@@ -7,7 +7,7 @@
 #include <cstring>
 #include <utility>
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::hal::replay {
 namespace {
 
 // Everything before the frames: the fixed part every event keeps.
@@ -214,4 +214,4 @@ void ReplayStream::diverge(DivergenceKind kind, std::int64_t log_event, const Bu
   kind_.store(kind, std::memory_order_release);
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::hal::replay

@@ -1,8 +1,8 @@
-#include "hal/mock/canopen_node.hpp"
+#include "sim/devices/canopen_encoder_node.hpp"
 
 #include <cmath>
 
-namespace rtfuse::hal::mock {
+namespace rtfuse::sim {
 
 namespace {
 constexpr TimeNs kNsPerSecond = 1'000'000'000;
@@ -91,12 +91,12 @@ void CanopenEncoderNode::set_stuck(bool stuck, TimeNs now) noexcept {
   stuck_ = stuck;
 }
 
-void CanopenEncoderNode::boot(TimeNs now, MockCanBus& bus) noexcept {
+void CanopenEncoderNode::boot(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
   booted_ = true;
   ++boot_count_;
   state_ = canopen::NmtState::kPreOperational;
   next_heartbeat_ = now + config_.heartbeat_period_ns;
-  CanFrame f;
+  hal::CanFrame f;
   f.id = canopen::kHeartbeatBase + config_.node_id;
   f.dlc = 1;
   f.data[0] = static_cast<std::uint8_t>(canopen::NmtState::kBootUp);
@@ -104,9 +104,9 @@ void CanopenEncoderNode::boot(TimeNs now, MockCanBus& bus) noexcept {
 }
 
 bool CanopenEncoderNode::emit_emcy(std::uint16_t error_code, std::uint8_t error_register,
-                                   const std::uint8_t manufacturer[5], TimeNs now, MockCanBus& bus) noexcept {
+                                   const std::uint8_t manufacturer[5], TimeNs now, hal::mock::MockCanBus& bus) noexcept {
   if (silent_ || !booted_ || state_ == canopen::NmtState::kStopped) return false;
-  CanFrame f;
+  hal::CanFrame f;
   f.id = canopen::kEmcyBase + config_.node_id;
   f.dlc = 8;
   f.data[0] = static_cast<std::uint8_t>(error_code & 0xFF);
@@ -116,8 +116,8 @@ bool CanopenEncoderNode::emit_emcy(std::uint16_t error_code, std::uint8_t error_
   return bus.inject_at(f, now);
 }
 
-void CanopenEncoderNode::send_tpdo(TimeNs now, MockCanBus& bus) noexcept {
-  CanFrame f;
+void CanopenEncoderNode::send_tpdo(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+  hal::CanFrame f;
   f.id = config_.tpdo_cob_id;
   f.dlc = config_.tpdo_dlc;
   const std::uint64_t raw = static_cast<std::uint64_t>(counts_at(now));
@@ -127,7 +127,7 @@ void CanopenEncoderNode::send_tpdo(TimeNs now, MockCanBus& bus) noexcept {
   if (bus.inject_at(f, now)) ++tpdo_count_;
 }
 
-void CanopenEncoderNode::handle_nmt(const CanFrame& frame, TimeNs now, MockCanBus& bus) noexcept {
+void CanopenEncoderNode::handle_nmt(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept {
   // CiA 301 NMT node control is exactly two bytes; stacks drop anything else.
   if (frame.dlc != 2) return;
   const std::uint8_t target = frame.data[1];
@@ -146,7 +146,7 @@ void CanopenEncoderNode::handle_nmt(const CanFrame& frame, TimeNs now, MockCanBu
   }
 }
 
-void CanopenEncoderNode::on_frame(const CanFrame& frame, TimeNs now, MockCanBus& bus) noexcept {
+void CanopenEncoderNode::on_frame(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept {
   if (silent_ || !booted_ || frame.extended || frame.rtr || frame.error) return;
   advance(now, bus);  // a heartbeat due before this frame goes out first
   if (frame.id == canopen::kNmtCobId) {
@@ -156,7 +156,7 @@ void CanopenEncoderNode::on_frame(const CanFrame& frame, TimeNs now, MockCanBus&
   }
 }
 
-void CanopenEncoderNode::advance(TimeNs now, MockCanBus& bus) noexcept {
+void CanopenEncoderNode::advance(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
   if (!base_time_set_) {
     base_time_ = now;
     base_time_set_ = true;
@@ -174,7 +174,7 @@ void CanopenEncoderNode::advance(TimeNs now, MockCanBus& bus) noexcept {
       next_heartbeat_ += ((now - next_heartbeat_) / period + 1) * period;
       break;
     }
-    CanFrame f;
+    hal::CanFrame f;
     f.id = canopen::kHeartbeatBase + config_.node_id;
     f.dlc = 1;
     f.data[0] = static_cast<std::uint8_t>(state_);
@@ -184,4 +184,4 @@ void CanopenEncoderNode::advance(TimeNs now, MockCanBus& bus) noexcept {
   }
 }
 
-}  // namespace rtfuse::hal::mock
+}  // namespace rtfuse::sim

@@ -1,0 +1,63 @@
+#pragma once
+// The MPU IMU as a thread device: each step waits for one data-ready edge (or
+// the next poll), reads the chip, filters attitude and pushes one sample into
+// the IMU sensor's ring; its health crosses to the loop through a seqlock.
+#include <atomic>
+#include <memory>
+#include <string>
+
+#include "core/seqlock.hpp"
+#include "drivers/imu/mpu_imu.hpp"
+#include "runtime/device_layout.hpp"
+#include "runtime/fusion_core.hpp"
+#include "runtime/hal_buses.hpp"
+#include "runtime/thread_device.hpp"
+
+namespace rtfuse {
+
+// base_R_imu comes from the frame tree: the static transform base_link -> mpu.frame.
+bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& frames, drivers::MpuImuConfig* out,
+                       std::string* error);
+
+class ImuDevice final : public ThreadDevice {
+ public:
+  // The configuration is the core's; buses.i2c and buses.clock are required.
+  static std::unique_ptr<ImuDevice> create(const ImuBuses& buses, FusionCore& core, int device_slot,
+                                           std::string* error);
+
+  // Before the threads: identity check and configuration of the chip.
+  bool start(std::string* error);
+
+  const char* name() const noexcept override { return "imu"; }
+  void step(TimeNs timeout_ns) noexcept override { step_imu(timeout_ns); }
+  int sensor() const noexcept override { return sensor_; }
+  std::int64_t samples() const noexcept override { return samples_.load(std::memory_order_acquire); }
+  void fill_snapshot(Snapshot& s) noexcept override;
+
+  // One step with the driver's verdict (tests look at it).
+  drivers::StepResult step_imu(TimeNs timeout_ns) noexcept;
+
+ private:
+  ImuDevice(FusionCore& core, int device_slot);
+
+  // What the IMU thread shares with the loop.
+  struct Health {
+    drivers::MpuImuStats stats;
+    drivers::StepResult last = drivers::StepResult::kDown;
+    double temperature_c = 0.0;
+    std::int64_t last_sample_ns = 0;
+  };
+
+  FusionCore& core_;
+  int sensor_ = -1;
+  int slot_ = -1;
+  std::unique_ptr<drivers::MpuImu> imu_;
+  est::SensorSample sample_;
+  drivers::ImuMeasurement measurement_;
+  Health scratch_;
+  SeqLock<Health> health_;
+  std::atomic<std::int64_t> samples_{0};
+  static_assert(std::atomic<std::int64_t>::is_always_lock_free);
+};
+
+}  // namespace rtfuse
