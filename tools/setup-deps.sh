@@ -22,6 +22,9 @@ packages=(
   # tools/deploy.sh (ssh), and its test (tests/deploy) boots a board with
   # systemd-nspawn from a debootstrap root
   openssh-client systemd-container
+  # the kernel system test (tests/kernel) boots Debian's own kernel under
+  # qemu with a busybox initramfs and runs the Linux backends on its drivers
+  qemu-system-x86 busybox-static cpio kmod
 )
 
 missing=()
