@@ -25,6 +25,9 @@ packages=(
   # the kernel system test (tests/kernel) boots Debian's own kernel under
   # qemu with a busybox initramfs and runs the Linux backends on its drivers
   qemu-system-x86 busybox-static cpio kmod
+  # the stereo rectification's reference in the test build (tests/reference);
+  # never linked into the runtime
+  libopencv-dev
 )
 
 missing=()
