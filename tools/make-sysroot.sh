@@ -35,6 +35,8 @@ packages=(
   libgpiod2 libgpiod-dev
   libeigen3-dev libtomlplusplus3 libtomlplusplus-dev libcli11-dev
   libgtest-dev libgmock-dev googletest libbenchmark1debian libbenchmark-dev
+  # the stereo PNG writer of the snapshot tool (src/apps/stereo_png.cpp)
+  libpng16-16 libpng-dev
 )
 
 mkdir -p "$dir"

@@ -13,6 +13,8 @@ packages=(
   python3 python3-rosbag python3-yaml python3-matplotlib
   iproute2 util-linux
   linux-libc-dev libgpiod-dev
+  # the stereo PNG writer of the snapshot tool (src/apps/stereo_png.cpp)
+  libpng-dev
   binutils libc6-dev
   # the aarch64 stage (tools/test-cross.sh): cross compiler, user-mode
   # emulation, and the arm64 package installed in a clean arm64 root

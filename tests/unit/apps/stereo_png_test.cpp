@@ -1,0 +1,155 @@
+// write_stereo_png, read back with libpng: size, format, each eye's pixels,
+// the guide lines, and errors that name the path and the errno text.
+#include "apps/stereo_png.hpp"
+
+#include <gtest/gtest.h>
+#include <png.h>
+#include <sys/stat.h>
+#include <unistd.h>
+
+#include <cstdint>
+#include <cstdio>
+#include <fstream>
+#include <string>
+#include <vector>
+
+namespace rtfuse::apps {
+namespace {
+
+struct Rgb {
+  int width = 0, height = 0;
+  std::vector<std::uint8_t> px;
+  const std::uint8_t* at(int x, int y) const { return &px[(static_cast<std::size_t>(y) * width + x) * 3]; }
+};
+
+// The file as libpng reads it; fails the test unless it is 8-bit RGB.
+Rgb read_png(const std::string& path) {
+  Rgb out;
+  png_image image{};
+  image.version = PNG_IMAGE_VERSION;
+  if (!png_image_begin_read_from_file(&image, path.c_str())) {
+    ADD_FAILURE() << path << ": " << image.message;
+    return out;
+  }
+  EXPECT_EQ(image.format, static_cast<png_uint_32>(PNG_FORMAT_RGB)) << "8-bit RGB, no alpha";
+  image.format = PNG_FORMAT_RGB;
+  out.width = static_cast<int>(image.width);
+  out.height = static_cast<int>(image.height);
+  out.px.resize(PNG_IMAGE_SIZE(image));
+  if (!png_image_finish_read(&image, nullptr, out.px.data(), 0, nullptr)) {
+    ADD_FAILURE() << path << ": " << image.message;
+    out = Rgb{};
+  }
+  return out;
+}
+
+std::string temp_path(const char* name) {
+  return ::testing::TempDir() + "rtfuse_stereo_png_" + std::to_string(::getpid()) + "_" + name;
+}
+
+struct Pair {
+  static constexpr int kW = 64, kH = 40, kStride = 80;
+  std::vector<std::uint8_t> left, right;
+  Pair() : left(kStride * kH, 0xEE), right(kStride * kH, 0xEE) {
+    for (int y = 0; y < kH; ++y)
+      for (int x = 0; x < kW; ++x) {
+        left[y * kStride + x] = static_cast<std::uint8_t>(x + 2 * y);
+        right[y * kStride + x] = static_cast<std::uint8_t>(250 - x - y);
+      }
+  }
+};
+
+bool is_guide(const std::uint8_t* p) { return p[0] == kGuideRgb[0] && p[1] == kGuideRgb[1] && p[2] == kGuideRgb[2]; }
+
+TEST(StereoPng, EyesSideBySideWithGuideLines) {
+  const Pair pair;
+  const std::string path = temp_path("guides.png");
+  std::string error;
+  ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
+                               &error))
+      << error;
+  const Rgb img = read_png(path);
+  ASSERT_EQ(img.width, 2 * Pair::kW);
+  ASSERT_EQ(img.height, Pair::kH);
+
+  // A pixel of each eye, by hand: left (5, 3) = 5 + 6; right (5, 3) = 250 - 8.
+  EXPECT_EQ(img.at(5, 3)[0], 11);
+  EXPECT_EQ(img.at(5, 3)[1], 11);
+  EXPECT_EQ(img.at(5, 3)[2], 11);
+  EXPECT_EQ(img.at(Pair::kW + 5, 3)[0], 242);
+  EXPECT_EQ(img.at(Pair::kW + 5, 3)[1], 242);
+  EXPECT_EQ(img.at(Pair::kW + 5, 3)[2], 242);
+  // A guide-line pixel in each half.
+  EXPECT_TRUE(is_guide(img.at(5, 20)));
+  EXPECT_TRUE(is_guide(img.at(Pair::kW + 40, 30)));
+
+  // Everywhere: rows 10, 20, 30 green across both halves, grey elsewhere.
+  int wrong = 0;
+  for (int y = 0; y < img.height; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const std::uint8_t* p = img.at(x, y);
+      const bool guide = y > 0 && y % 10 == 0;
+      const int ex = x % Pair::kW;
+      const std::uint8_t grey = x < Pair::kW ? pair.left[y * Pair::kStride + ex] : pair.right[y * Pair::kStride + ex];
+      const bool ok = guide ? is_guide(p) : (p[0] == grey && p[1] == grey && p[2] == grey);
+      if (!ok && ++wrong <= 5) ADD_FAILURE() << "pixel (" << x << ", " << y << ")";
+    }
+  EXPECT_EQ(wrong, 0);
+  ::unlink(path.c_str());
+}
+
+TEST(StereoPng, NoGuideLinesWhenTheSpacingIsZero) {
+  const Pair pair;
+  const std::string path = temp_path("plain.png");
+  std::string error;
+  ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 0,
+                               &error))
+      << error;
+  const Rgb img = read_png(path);
+  ASSERT_EQ(img.height, Pair::kH);
+  EXPECT_EQ(img.at(5, 20)[0], 5 + 40);
+  EXPECT_EQ(img.at(5, 20)[1], 5 + 40);
+  ::unlink(path.c_str());
+}
+
+TEST(StereoPng, OpenErrorNamesThePathAndErrno) {
+  const Pair pair;
+  const std::string path = temp_path("no_such_dir") + "/pair.png";
+  std::string error;
+  EXPECT_FALSE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
+                                &error));
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("No such file or directory"), std::string::npos) << error;
+}
+
+TEST(StereoPng, WriteErrorNamesErrnoAndKeepsTheDevice) {
+  if (::access("/dev/full", W_OK) != 0) GTEST_SKIP() << "no writable /dev/full";
+  const Pair pair;
+  std::string error;
+  EXPECT_FALSE(write_stereo_png("/dev/full", pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride,
+                                10, &error));
+  EXPECT_NE(error.find("/dev/full"), std::string::npos) << error;
+  EXPECT_NE(error.find("No space left on device"), std::string::npos) << error;
+  struct stat st {};
+  EXPECT_EQ(::stat("/dev/full", &st), 0) << "a device is never unlinked";
+}
+
+TEST(StereoPng, BadArgumentsLeaveAnExistingFileAlone) {
+  const Pair pair;
+  const std::string path = temp_path("keep.png");
+  { std::ofstream(path) << "previous snapshot"; }
+  std::string error;
+  EXPECT_FALSE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kW - 1, 10,
+                                &error));
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("stride 63"), std::string::npos) << error;
+  EXPECT_FALSE(write_stereo_png(path, nullptr, pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10, &error));
+  EXPECT_FALSE(write_stereo_png(path, pair.left.data(), pair.right.data(), 0, Pair::kH, Pair::kStride, 10, &error));
+  std::string content;
+  std::getline(std::ifstream(path), content);
+  EXPECT_EQ(content, "previous snapshot");
+  ::unlink(path.c_str());
+}
+
+}  // namespace
+}  // namespace rtfuse::apps
