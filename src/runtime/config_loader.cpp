@@ -418,7 +418,7 @@ void read_sim(const Section& s, LcmSimConfig& sim) {
 
 void read_root(const Section& root, RuntimeConfig& cfg) {
   root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "static_transform", "sim", "hardware",
-                       "can", "wheel_odometry", "mpu"});
+                       "can", "wheel_odometry", "mpu", "camera"});
   Diagnostics& d = root.diag();
   read_filter(Section(section_table(root, "filter"), "filter", d), cfg);
   read_realtime(Section(section_table(root, "realtime"), "realtime", d), cfg.realtime);

@@ -21,6 +21,12 @@ const char* const kImuKeys[] = {"samples",   "reads",     "nacks",         "bus_
                                 "reinits",   "filter_rejects", "temperature_mdegc"};
 const int kImuKeyCount = sizeof(kImuKeys) / sizeof(kImuKeys[0]);
 
+// fps_milli: the rate measured from the capture stamps, in 1/1000 fps.
+const char* const kCameraKeys[] = {"frames",    "fps_milli",       "dropped", "sequence_gaps",
+                                   "rejected_size", "rejected_corrupted", "pool_full", "timeouts",
+                                   "lost",      "reopen_attempts", "reopens", "errors"};
+const int kCameraKeyCount = sizeof(kCameraKeys) / sizeof(kCameraKeys[0]);
+
 DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
   DeviceSlots s;
   const HardwareConfig& hw = cfg.hardware;
@@ -31,6 +37,7 @@ DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
   }
   if (hw.wheel_sensor >= 0) s.wheel_odometry = s.count++;
   if (hw.mpu.enabled) s.imu = s.count++;
+  if (hw.camera.enabled) s.camera = s.count++;
   return s;
 }
 
@@ -77,6 +84,13 @@ int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexc
     std::snprintf(buf, sizeof buf, "%s 0x%02X", hw.mpu.device.c_str(), hw.mpu.address);
     d.hardware_id = buf;
     keys(d, kImuKeys, kImuKeyCount);
+  }
+  if (slots.camera >= 0) {
+    DeviceStatus& d = out[slots.camera];
+    d.name = "camera";
+    std::snprintf(buf, sizeof buf, "%s %s@%d", hw.camera.device.c_str(), hw.camera.resolution.c_str(), hw.camera.fps);
+    d.hardware_id = buf;
+    keys(d, kCameraKeys, kCameraKeyCount);
   }
   return slots.count;
 }

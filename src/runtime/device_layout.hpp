@@ -10,12 +10,13 @@
 namespace rtfuse {
 
 // Slot order: CAN bus, then one per encoder node in [[can.node]] order, then
-// wheel odometry, then the IMU.
+// wheel odometry, then the IMU, then the camera.
 struct DeviceSlots {
   int can_bus = -1;
   int first_node = -1;
   int wheel_odometry = -1;
   int imu = -1;
+  int camera = -1;
   int count = 0;
 };
 
@@ -33,6 +34,8 @@ extern const char* const kWheelOdometryKeys[];
 extern const int kWheelOdometryKeyCount;
 extern const char* const kImuKeys[];
 extern const int kImuKeyCount;
+extern const char* const kCameraKeys[];
+extern const int kCameraKeyCount;
 
 // Values in the order of the layout's keys, so the names are written in
 // one place only.

@@ -8,6 +8,7 @@
 #include "hal/clock.hpp"
 #include "hal/gpio.hpp"
 #include "hal/i2c_bus.hpp"
+#include "hal/video_stream.hpp"
 
 namespace rtfuse {
 
@@ -19,9 +20,17 @@ struct ImuBuses {
   hal::Clock* clock = nullptr;
 };
 
+// The camera thread's: the stereo camera's stream, and the clock it backs
+// off on while the camera is unplugged.
+struct CameraBuses {
+  hal::VideoStream* video = nullptr;
+  hal::Clock* clock = nullptr;
+};
+
 struct HalBuses {
   hal::CanBus* can = nullptr;  // the wheel encoders' bus, polled by the loop thread
   ImuBuses imu;
+  CameraBuses camera;
 };
 
 }  // namespace rtfuse

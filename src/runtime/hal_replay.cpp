@@ -10,6 +10,7 @@
 #include "hal/replay/replay_clock.hpp"
 #include "hal/replay/replay_gpio.hpp"
 #include "hal/replay/replay_i2c_bus.hpp"
+#include "hal/replay/replay_video_stream.hpp"
 #include "runtime/recording_tap.hpp"
 #include "runtime/tick_pipeline.hpp"
 
@@ -106,6 +107,21 @@ class ReplayOutput final : public OutputStage {
   std::uint32_t recorded_ = 0;
 };
 
+// The camera thread's clock is not recorded: its driver reads it only to
+// back off while the camera is unplugged. In replay that wait passes at
+// once; a recording whose camera was unplugged may therefore diverge at a
+// reopen, and says so, but never replays differently in silence.
+class FreeRunningClock final : public hal::Clock {
+ public:
+  TimeNs now() const noexcept override { return now_; }
+  void sleep_until(TimeNs t) noexcept override {
+    if (t > now_) now_ = t;
+  }
+
+ private:
+  TimeNs now_ = 0;
+};
+
 int stream_index(const transport::RecordingInfo& info, const char* name) {
   for (std::size_t i = 0; i < info.streams.size(); ++i) {
     if (info.streams[i] == name) return static_cast<int>(i);
@@ -134,6 +150,10 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   std::unique_ptr<hal::I2cBus> i2c;
   std::unique_ptr<hal::GpioEdgeSource> drdy;
   std::unique_ptr<hal::Clock> clock;
+  const int camera = stream_index(rec.info, kCameraStream);
+  std::unique_ptr<hal::VideoStream> video;
+  hal::replay::ReplayVideoLog* video_log = nullptr;
+  FreeRunningClock camera_clock;
   HalBuses buses;
   for (std::size_t d = 0; d < rec.info.devices.size(); ++d) {
     const transport::RecordedDevice& dev = rec.info.devices[d];
@@ -165,6 +185,15 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
         }
         break;
       case transport::DeviceKind::kGpioOutput: break;
+      case transport::DeviceKind::kVideo:
+        if (dev.stream == camera && !video && static_cast<std::size_t>(dev.stream) < rec.videos.size() &&
+            rec.videos[static_cast<std::size_t>(dev.stream)]) {
+          video_log = rec.videos[static_cast<std::size_t>(dev.stream)].get();
+          video = std::make_unique<hal::replay::ReplayVideoStream>(*video_log, index);
+          buses.camera.video = video.get();
+          buses.camera.clock = &camera_clock;
+        }
+        break;
     }
   }
   const HardwareConfig& hw = cfg.hardware;
@@ -174,6 +203,10 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   }
   if (hw.mpu.enabled && (buses.imu.i2c == nullptr || buses.imu.clock == nullptr)) {
     result.error = "the configuration has [mpu] but the recording has no I2C bus and clock of the IMU thread";
+    return result;
+  }
+  if (hw.camera.enabled && buses.camera.video == nullptr) {
+    result.error = "the configuration has [camera] but the recording has no camera stream";
     return result;
   }
   for (int i = 0; i < cfg.num_sensors; ++i) {
@@ -273,6 +306,28 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);
   }
+  // Devices that feed no sensor (the camera, until visual odometry) do not
+  // change what a tick publishes: their recorded calls are replayed after
+  // the ticks, through the same driver, in their recorded order.
+  if (video_log != nullptr && !result.diverged && !result.ended_early) {
+    for (int d = 0; d < pipeline->thread_device_count(); ++d) {
+      ThreadDevice& device = pipeline->thread_device(d);
+      if (std::string_view(device.name()) != kCameraStream) continue;
+      camera_clock.sleep_until(t0);
+      // Each step makes at least one call unless the driver is backing off,
+      // which the free-running clock ends at the next step: bounded.
+      for (std::size_t k = 0; k < 2 * video_log->size() + 16 && !video_log->diverged() && !video_log->at_end(); ++k) {
+        device.step(kDeviceStepTimeoutNs);
+      }
+      if (video_log->divergence_kind() == hal::replay::DivergenceKind::kMismatch) {
+        result.diverged = true;
+        result.error = std::string("replay diverged from the recording in stream 'camera': ") + video_log->divergence();
+      } else if (video_log->diverged()) {
+        result.ended_early = true;
+        result.note = std::string("the recording of stream 'camera' ends early: ") + video_log->divergence();
+      }
+    }
+  }
   if (progress) progress(prog);
   result.published = sink.published;
   result.compared = sink.compared;
@@ -280,6 +335,8 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   result.first_mismatch = sink.first_mismatch;
   result.recorded_not_reproduced = sink.not_reproduced();
   pipeline->core().snapshot().load(result.final);
+  // Device health as of now, the camera's replayed frames included.
+  if (pipeline->hardware() != nullptr) pipeline->hardware()->fill_snapshot(result.final);
   if (!sink.error.empty()) {
     result.error = "writing the output log: " + sink.error;
     return result;

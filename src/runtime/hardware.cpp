@@ -23,6 +23,11 @@ std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& co
     if (!h->imu_) return nullptr;
     h->threaded_[h->num_threaded_++] = h->imu_.get();
   }
+  if (hw.camera.enabled) {
+    h->camera_ = CameraDevice::create(buses.camera, core, h->slots_.camera, error);
+    if (!h->camera_) return nullptr;
+    h->threaded_[h->num_threaded_++] = h->camera_.get();
+  }
   return h;
 }
 

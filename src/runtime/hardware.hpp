@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 
+#include "runtime/camera_device.hpp"
 #include "runtime/device_layout.hpp"
 #include "runtime/fusion_core.hpp"
 #include "runtime/hal_buses.hpp"
@@ -40,6 +41,7 @@ class Hardware final : public TickDevices {
   ThreadDevice& thread_device(int i) { return *threaded_[i]; }
 
   ImuDevice* imu() { return imu_.get(); }
+  CameraDevice* camera() { return camera_.get(); }
   const drivers::CanopenEncoders* encoders() const { return wheels_ ? &wheels_->encoders() : nullptr; }
   const drivers::WheelOdometry* wheel_odometry() const { return wheels_ ? wheels_->wheel_odometry() : nullptr; }
 
@@ -50,6 +52,7 @@ class Hardware final : public TickDevices {
   DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
   std::unique_ptr<WheelEncoderDevice> wheels_;
   std::unique_ptr<ImuDevice> imu_;
+  std::unique_ptr<CameraDevice> camera_;
   ThreadDevice* threaded_[kMaxThreadDevices] = {};
   int num_threaded_ = 0;
 };

@@ -88,12 +88,32 @@ struct MpuSection {
   AttitudeSection attitude;
 };
 
+// [camera]: a ZED-class stereo camera on V4L2 (or the simulated robot's).
+struct CameraSection {
+  bool enabled = false;
+  HwName device{"/dev/video0"};
+  std::string calibration_file;  // the factory SN<serial>.conf (resolved path)
+  std::int64_t serial = 0;       // 0: any; else the file must be this camera's
+  HwName resolution{"VGA"};      // 2K, FHD, HD, VGA
+  int fps = 30;
+  int buffers = 4;               // V4L2 mmap buffers
+  int pool_frames = 4;           // rectified pairs lent to consumers
+  HwName frame{"camera_optical"};  // the left eye's optical frame: static transform base_link -> frame
+  double reopen_backoff_s = 0.25;  // first wait before reopening an unplugged camera
+  double reopen_backoff_max_s = 8.0;
+  HwName info_channel{"rtfuse/camera/info"};        // camera_info_t of the rectified left eye
+  HwName preview_channel{"rtfuse/camera/preview"};  // image_t, both eyes side by side
+  double preview_rate_hz = 1.0;  // 0: no preview
+  int preview_downscale = 2;
+};
+
 struct HardwareConfig {
   HalBackend backend = HalBackend::kNone;
   std::string scenario;  // backend "sim": the drive scenario file (resolved path)
   CanSection can;
   WheelOdometrySection wheel_odometry;
   MpuSection mpu;
+  CameraSection camera;
   int wheel_sensor = -1;  // index of the [[sensor]] with source = "wheel_odometry"
   int mpu_sensor = -1;    // index of the [[sensor]] with source = "mpu"
 };

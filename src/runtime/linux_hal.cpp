@@ -1,9 +1,12 @@
 #include "runtime/linux_hal.hpp"
 
+#include "drivers/camera/camera_modes.hpp"
+#include "drivers/camera/zed_usb_hint.hpp"
 #include "hal/linux/gpiod_line.hpp"
 #include "hal/linux/i2c_dev_bus.hpp"
 #include "hal/linux/monotonic_clock.hpp"
 #include "hal/linux/socketcan_bus.hpp"
+#include "hal/linux/v4l2_stream.hpp"
 
 namespace rtfuse {
 
@@ -11,6 +14,7 @@ struct LinuxHal::Devices {
   std::unique_ptr<hal::SocketCanBus> can;
   std::unique_ptr<hal::I2cDevBus> i2c;
   std::unique_ptr<hal::GpiodEdgeSource> drdy;
+  std::unique_ptr<hal::V4l2Stream> video;
   hal::MonotonicClock clock;
 };
 
@@ -54,6 +58,26 @@ std::unique_ptr<LinuxHal> LinuxHal::open(const RuntimeConfig& cfg, std::string* 
       h->buses_.imu.data_ready = d.drdy.get();
     }
     h->buses_.imu.clock = &d.clock;
+  }
+  if (hw.camera.enabled) {
+    const CameraSection& c = hw.camera;
+    drivers::CameraMode mode;
+    if (!drivers::find_camera_mode(c.resolution.view(), c.fps, &mode, error)) return nullptr;
+    hal::VideoRequest req;
+    req.pixel_format = hal::kFourccYuyv;
+    req.width = drivers::side_by_side_width(mode);
+    req.height = drivers::side_by_side_height(mode);
+    req.fps = c.fps;
+    req.buffers = c.buffers;
+    hal::V4l2OpenFailure failure;
+    d.video = hal::V4l2Stream::open(c.device.c_str(), req, error, &failure);
+    if (!d.video) {
+      // A ZED on USB 2 offers VGA only; the refusal alone does not say so.
+      *error += drivers::zed_usb2_hint(mode, failure.given, failure.offered);
+      return nullptr;
+    }
+    h->buses_.camera.video = d.video.get();
+    h->buses_.camera.clock = &d.clock;
   }
   return h;
 }

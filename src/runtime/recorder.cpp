@@ -13,6 +13,9 @@ namespace {
 
 // Records per ring per pass: bounds how long one busy ring can starve the others.
 constexpr int kBatch = 256;
+// Video records per ring per pass: one can be a 1 MB frame, so fewer, or the
+// bus rings would wait for a whole batch of frames to reach the disk.
+constexpr int kVideoBatch = 8;
 
 void set_error(std::string* error, std::string message) {
   if (error != nullptr) *error = std::move(message);
@@ -64,9 +67,57 @@ int Recorder::stream_index(std::string_view name) const {
   return -1;
 }
 
+hal::VideoRecordRing* Recorder::add_video_ring(int stream, std::size_t slot_bytes, std::size_t frame_slots,
+                                               std::size_t events, std::string* error) {
+  if (thread_.joinable() || stopped_) {
+    set_error(error, "recording: add_video_ring after the recorder started");
+    return nullptr;
+  }
+  if (stream < 0 || stream >= stream_count()) {
+    set_error(error, "recording: add_video_ring: stream " + std::to_string(stream) + " does not exist");
+    return nullptr;
+  }
+  bool has_video = false;
+  for (const transport::RecordedDevice& d : info_.devices) {
+    if (d.stream == stream && d.kind == transport::DeviceKind::kVideo) has_video = true;
+  }
+  if (!has_video) {
+    set_error(error, "recording: stream '" + info_.streams[static_cast<std::size_t>(stream)] +
+                         "' has no video device in the recording info");
+    return nullptr;
+  }
+  for (const VideoRing& v : video_rings_) {
+    if (v.stream == stream) {
+      set_error(error, "recording: stream '" + info_.streams[static_cast<std::size_t>(stream)] +
+                           "' already has a video ring");
+      return nullptr;
+    }
+  }
+  constexpr std::size_t kMaxSlotBytes = 256u << 20;  // far above any frame; keeps the record an LCM int size
+  if (slot_bytes == 0 || slot_bytes > kMaxSlotBytes || frame_slots == 0) {
+    set_error(error, "recording: add_video_ring: slot_bytes " + std::to_string(slot_bytes) + " and frame_slots " +
+                         std::to_string(frame_slots) + " (need 1.." + std::to_string(kMaxSlotBytes) +
+                         " bytes, at least one slot)");
+    return nullptr;
+  }
+  if (events == 0) events = 4 * frame_slots + 64;
+  VideoRing v;
+  v.stream = stream;
+  v.ring = std::make_unique<hal::VideoRecordRing>(slot_bytes, frame_slots, events);
+  const std::size_t need = slot_bytes + static_cast<std::size_t>(transport::kVideoRecordOverhead);
+  if (video_buf_.size() < need) video_buf_.resize(need);
+  video_rings_.push_back(std::move(v));
+  return video_rings_.back().ring.get();
+}
+
 bool Recorder::backlogged() const noexcept {
   for (const auto& r : rings_) {
     if (2 * r->size() > r->capacity()) return true;
+  }
+  for (const VideoRing& v : video_rings_) {
+    if (2 * v.ring->frames() > v.ring->frame_capacity() || 2 * v.ring->events() > v.ring->event_capacity()) {
+      return true;
+    }
   }
   return 2 * ticks_.size() > ticks_.capacity() || 2 * outputs_.size() > outputs_.capacity();
 }
@@ -202,6 +253,35 @@ std::size_t Recorder::drain_once() noexcept {
       ++written;
     }
   }
+  for (VideoRing& v : video_rings_) {
+    for (int i = 0; i < kVideoBatch; ++i) {
+      const std::uint8_t* frame = nullptr;
+      const hal::VideoEvent* ev = v.ring->peek(&frame);
+      if (ev == nullptr) break;
+      if (ev->lost_before > 0) {
+        bus_lost_[static_cast<std::size_t>(v.stream)].fetch_add(ev->lost_before, std::memory_order_relaxed);
+      }
+      if (ev->frames_before > v.next_frame) {
+        video_frames_lost_.fetch_add(ev->frames_before - v.next_frame, std::memory_order_relaxed);
+      }
+      v.next_frame = ev->frames_before + (ev->has_frame() ? 1 : 0);
+      int n = -1;
+      try {
+        n = codec_.encode_video(*ev, frame, video_buf_.data(), static_cast<int>(video_buf_.size()));
+      } catch (const std::exception&) {
+        n = -1;  // the codec's first encode of the largest frame allocates
+      }
+      if (n < 0) {
+        encode_errors_.fetch_add(1, std::memory_order_relaxed);
+      } else {
+        const TimeNs t = ev->time_ns != 0 ? ev->time_ns : monotonic_now_ns();
+        write(ns_to_utime(t), codec_.channel(ev->device), video_buf_.data(), static_cast<std::size_t>(n));
+        if (ev->has_frame()) video_frames_written_.fetch_add(1, std::memory_order_relaxed);
+      }
+      v.ring->pop();
+      ++written;
+    }
+  }
   for (int i = 0; i < kBatch; ++i) {
     const TickSlot* tick = ticks_.peek();
     if (tick == nullptr) break;
@@ -243,6 +323,8 @@ RecorderStats Recorder::stats() const {
   s.ticks_rejected = ticks_rejected_.load(std::memory_order_relaxed);
   s.outputs_lost = outputs_lost_.load(std::memory_order_relaxed);
   s.outputs_rejected = outputs_rejected_.load(std::memory_order_relaxed);
+  s.video_frames_written = video_frames_written_.load(std::memory_order_relaxed);
+  s.video_frames_lost = video_frames_lost_.load(std::memory_order_relaxed);
   return s;
 }
 

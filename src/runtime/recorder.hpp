@@ -11,6 +11,13 @@
 // empty. The file starts with the recording_info_t, written by create(), so
 // even a recorder killed at once leaves a recognisable recording.
 //
+// A camera records through a VideoRecordRing instead (add_video_ring before
+// start): heads of every call plus large frame slots, sized from the
+// negotiated format. The writer encodes one hal_video_t per call. At VGA
+// side-by-side YUYV 30 fps that is ~30 MB/s to the disk; a disk slower than
+// that fills the frame slots and the camera's decorator drops (and counts)
+// records, the camera thread never waits.
+//
 // File order is drain order: events of one stream stay in call order, ticks
 // in tick order, outputs in publish order; nothing orders one ring against
 // another (replay does not need it: each thread replays its own stream).
@@ -27,6 +34,7 @@
 #include "core/spsc_ring.hpp"
 #include "core/time.hpp"
 #include "hal/bus_event.hpp"
+#include "hal/video_event.hpp"
 #include "runtime/config.hpp"
 #include "runtime/publisher.hpp"
 #include "transport/event_log.hpp"
@@ -53,6 +61,11 @@ struct RecorderStats {
   std::int64_t ticks_rejected = 0;    // more sensors than a tick record holds
   std::int64_t outputs_lost = 0;      // output ring full
   std::int64_t outputs_rejected = 0;  // larger than kMaxOutputBytes or a bad channel name
+  // Video rings: frames written, and frames lost to a full ring as the
+  // records after each hole report them (their calls also count in
+  // bus_events_lost of the camera's stream).
+  std::int64_t video_frames_written = 0;
+  std::int64_t video_frames_lost = 0;
 };
 
 namespace recorder_detail {
@@ -101,6 +114,16 @@ class Recorder {
   // The ring the decorators of `stream`'s thread push into (0 <= stream < stream_count()).
   SpscRing<hal::BusEvent>& ring(int stream) { return *rings_[static_cast<std::size_t>(stream)]; }
 
+  // The ring a camera's RecordingVideoStream pushes into, for `stream` (the
+  // camera's own stream: info lists only video devices on it). slot_bytes:
+  // the negotiated format's image_size; frame_slots: frames it can hold
+  // while the disk lags (each slot_bytes of memory); events: call heads
+  // (0: 4 per frame slot + 64, room for the releases and timeouts between
+  // frames). Call before start(), from the thread that calls start(). Null
+  // with the reason for a bad stream or size, or after start().
+  hal::VideoRecordRing* add_video_ring(int stream, std::size_t slot_bytes, std::size_t frame_slots,
+                                       std::size_t events = 0, std::string* error = nullptr);
+
   // Loop thread only. consumed[i]: samples taken from sensor i's ring since
   // start, up to and including this tick. False: not recorded (ring full, or
   // n outside 0..kMaxTickSensors), counted.
@@ -140,6 +163,13 @@ class Recorder {
   transport::HalRecordCodec codec_;
   transport::EventLogWriter writer_;
   std::vector<std::unique_ptr<SpscRing<hal::BusEvent>>> rings_;
+  struct VideoRing {
+    int stream = 0;
+    std::unique_ptr<hal::VideoRecordRing> ring;
+    std::int64_t next_frame = 0;  // writer thread: frame number the next record should follow
+  };
+  std::vector<VideoRing> video_rings_;
+  std::vector<std::uint8_t> video_buf_;  // encode buffer, sized by add_video_ring
   SpscRing<TickSlot> ticks_;
   SpscRing<OutputSlot> outputs_;
   // Producer-side staging: one per producing thread, so an 8 KiB slot is not
@@ -161,6 +191,8 @@ class Recorder {
   std::atomic<std::int64_t> ticks_rejected_{0};
   std::atomic<std::int64_t> outputs_lost_{0};
   std::atomic<std::int64_t> outputs_rejected_{0};
+  std::atomic<std::int64_t> video_frames_written_{0};
+  std::atomic<std::int64_t> video_frames_lost_{0};
 };
 
 // A MessageSink that publishes through `inner` and records every message it

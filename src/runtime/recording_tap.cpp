@@ -19,6 +19,9 @@ std::string can_device_name(const RuntimeConfig& cfg) {
   return device_name(cfg.hardware.can.interface.view(), "can");
 }
 std::string i2c_device_name(const RuntimeConfig& cfg) { return device_name(cfg.hardware.mpu.device.view(), "i2c"); }
+std::string video_device_name(const RuntimeConfig& cfg) {
+  return device_name(cfg.hardware.camera.device.view(), "video");
+}
 
 RecordingTap::~RecordingTap() = default;
 
@@ -33,6 +36,9 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
   info.config_text = config_text;
   info.config_hash = transport::config_text_hash(config_text);
   info.streams = {kLoopStream, kImuStream};
+  // The camera's calls go through a ring of their own (frames are large), on
+  // a stream of their own; a configuration without one records as before.
+  if (inner.camera.video != nullptr) info.streams.push_back(kCameraStream);
   int can = -1, i2c = -1, drdy = -1, imu_clock = -1;
   auto add = [&info](std::string name, transport::DeviceKind kind, int stream) {
     info.devices.push_back({std::move(name), kind, stream});
@@ -44,6 +50,7 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
   if (inner.imu.clock != nullptr && inner.imu.i2c != nullptr) {
     imu_clock = add("imu-clock", transport::DeviceKind::kClock, 1);
   }
+  const int camera = inner.camera.video != nullptr ? add(video_device_name(cfg), transport::DeviceKind::kVideo, 2) : -1;
   runtime::RecorderRingSizes sizes;
   // A second of the loop at 1 kHz and of a 1 kHz IMU, so a writer stalled
   // by the disk for that long loses nothing.
@@ -72,6 +79,16 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
         std::make_unique<hal::RecordingClock>(*inner.imu.clock, r.ring(1), static_cast<std::uint8_t>(imu_clock));
     b.imu.clock = t->imu_clock_.get();
   }
+  if (camera >= 0) {
+    // Eight frames (a quarter of a second at 30 fps) ride out a disk that
+    // stalls; beyond that the camera thread drops records, never waits.
+    hal::VideoRecordRing* ring = r.add_video_ring(2, inner.camera.video->format().image_size, 8, 0, error);
+    if (ring == nullptr) return nullptr;
+    t->camera_ = std::make_unique<hal::RecordingVideoStream>(*inner.camera.video, *ring,
+                                                             static_cast<std::uint8_t>(camera), &clock);
+    b.camera.video = t->camera_.get();
+    b.camera.clock = inner.camera.clock;
+  }
   return t;
 }
 
@@ -81,6 +98,7 @@ std::int64_t RecordingTap::overflows() const {
   if (i2c_) n += i2c_->overflows();
   if (drdy_) n += drdy_->overflows();
   if (imu_clock_) n += imu_clock_->overflows();
+  if (camera_) n += camera_->overflows();
   return n;
 }
 

@@ -4,7 +4,10 @@
 // ones and never know they are recorded. Which device is on which thread is
 // fixed here and read back by hal_replay.cpp:
 //   stream "loop": the CAN bus (polled inside the tick);
-//   stream "imu":  the I2C bus, the data-ready line, the IMU thread's clock.
+//   stream "imu":  the I2C bus, the data-ready line, the IMU thread's clock;
+//   stream "camera": the camera's video stream (frames in a ring of their
+//   own; the camera thread's clock is not recorded: its driver reads it only
+//   to back off while the camera is unplugged).
 #include <memory>
 #include <string>
 
@@ -12,6 +15,7 @@
 #include "hal/recording_clock.hpp"
 #include "hal/recording_gpio.hpp"
 #include "hal/recording_i2c_bus.hpp"
+#include "hal/recording_video_stream.hpp"
 #include "runtime/config.hpp"
 #include "runtime/hal_buses.hpp"
 #include "runtime/recorder.hpp"
@@ -22,6 +26,7 @@ namespace rtfuse {
 // by its name() (the IMU's is "imu").
 constexpr const char* kLoopStream = "loop";
 constexpr const char* kImuStream = "imu";
+constexpr const char* kCameraStream = "camera";
 
 class RecordingTap {
  public:
@@ -45,11 +50,13 @@ class RecordingTap {
   std::unique_ptr<hal::RecordingI2cBus> i2c_;
   std::unique_ptr<hal::RecordingEdgeSource> drdy_;
   std::unique_ptr<hal::RecordingClock> imu_clock_;
+  std::unique_ptr<hal::RecordingVideoStream> camera_;
   HalBuses buses_;
 };
 
 // The device names a recording uses for a configuration's buses.
 std::string can_device_name(const RuntimeConfig& cfg);
 std::string i2c_device_name(const RuntimeConfig& cfg);
+std::string video_device_name(const RuntimeConfig& cfg);
 
 }  // namespace rtfuse

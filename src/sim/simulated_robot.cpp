@@ -71,6 +71,10 @@ std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg,
   r->t0_ = t0;
   r->encoders_ = std::make_unique<SimEncoders>(r->scenario_, *r->truth_, clock, t0);
   r->imu_ = std::make_unique<SimImu>(r->scenario_, *r->truth_, clock, t0);
+  if (hw.camera.enabled) {
+    r->camera_ = SimCamera::create(cfg, *r->truth_, clock, t0, r->scenario_.seed, error);
+    if (!r->camera_) return nullptr;
+  }
   return r;
 }
 
@@ -80,6 +84,10 @@ HalBuses SimulatedRobot::buses() {
   b.imu.i2c = imu_.get();
   b.imu.data_ready = imu_.get();
   b.imu.clock = clock_;
+  if (camera_) {
+    b.camera.video = &camera_->stream();
+    b.camera.clock = clock_;
+  }
   return b;
 }
 
@@ -101,6 +109,7 @@ const std::uint8_t* GroundTruthEncoder::encode(const TruthState& truth, TimeNs s
 
 TimeNs SimulatedRobot::next_event_time(std::string_view name) const noexcept {
   if (name == "imu" && imu_) return imu_->next_edge_time();
+  if (name == "camera" && camera_) return camera_->next_frame_time();
   return std::numeric_limits<TimeNs>::max();
 }
 

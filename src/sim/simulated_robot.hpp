@@ -14,6 +14,7 @@
 #include "runtime/config.hpp"
 #include "runtime/hal_buses.hpp"
 #include "sim/drive_scenario.hpp"
+#include "sim/sim_camera.hpp"
 #include "sim/sim_encoders.hpp"
 #include "sim/sim_imu.hpp"
 #include "sim/truth_trajectory.hpp"
@@ -36,12 +37,14 @@ class SimulatedRobot {
   const TruthTrajectory& truth() const { return *truth_; }
   SimImu& imu() { return *imu_; }
   SimEncoders& encoders() { return *encoders_; }
+  SimCamera* camera() { return camera_.get(); }  // null without [camera]
   TimeNs start_time() const { return t0_; }
   // The drive's length (scenario duration, or the path's).
   double duration_s() const;
   TruthState truth_at(TimeNs t) const noexcept;
-  // When the simulated device behind the thread device `name` ("imu") next
-  // has something for its driver (a data-ready edge); far in the future for
+  // When the simulated device behind the thread device `name` ("imu",
+  // "camera") next has something for its driver (a data-ready edge, a
+  // frame's end of exposure); far in the future for
   // a device this robot does not simulate. The lockstep drive steps each
   // thread device up to the tick with it.
   TimeNs next_event_time(std::string_view name) const noexcept;
@@ -52,6 +55,7 @@ class SimulatedRobot {
   std::unique_ptr<TruthTrajectory> truth_;
   std::unique_ptr<SimEncoders> encoders_;
   std::unique_ptr<SimImu> imu_;
+  std::unique_ptr<SimCamera> camera_;
   hal::Clock* clock_ = nullptr;
   TimeNs t0_ = 0;
 };

@@ -9,6 +9,7 @@
 #include "rtfuse/hal_clock_t.hpp"
 #include "rtfuse/hal_gpio_t.hpp"
 #include "rtfuse/hal_i2c_t.hpp"
+#include "rtfuse/hal_video_t.hpp"
 #include "rtfuse/loop_tick_t.hpp"
 #include "rtfuse/recording_info_t.hpp"
 #include "transport/encode_buffer.hpp"
@@ -105,6 +106,7 @@ const char* to_string(DeviceKind k) noexcept {
     case DeviceKind::kGpioEdge: return "gpio-edge";
     case DeviceKind::kGpioOutput: return "gpio-output";
     case DeviceKind::kClock: return "clock";
+    case DeviceKind::kVideo: return "video";
   }
   return "unknown";
 }
@@ -116,6 +118,7 @@ bool records(DeviceKind device, BusEventKind call) noexcept {
     case DeviceKind::kGpioEdge: return call == BusEventKind::kGpioWaitEdge;
     case DeviceKind::kGpioOutput: return call == BusEventKind::kGpioSet;
     case DeviceKind::kClock: return call == BusEventKind::kClockNow || call == BusEventKind::kClockSleepUntil;
+    case DeviceKind::kVideo: return false;  // hal_video_t, through HalRecordCodec::encode_video
   }
   return false;
 }
@@ -150,7 +153,7 @@ bool validate(const RecordingInfo& info, std::string* error) {
                            " characters without '/' or spaces (it becomes the channel rtfuse/hal/<name>)");
       return false;
     }
-    if (static_cast<int>(d.kind) > static_cast<int>(DeviceKind::kClock)) {
+    if (static_cast<int>(d.kind) > static_cast<int>(DeviceKind::kVideo)) {
       set_error(error, where + ": unknown device kind " + std::to_string(static_cast<int>(d.kind)));
       return false;
     }
@@ -162,6 +165,15 @@ bool validate(const RecordingInfo& info, std::string* error) {
     for (std::size_t j = 0; j < i; ++j) {
       if (info.devices[j].name == d.name) {
         set_error(error, where + ": the name is also device " + std::to_string(j) + "'s");
+        return false;
+      }
+      // Video calls travel in their own ring: the log keeps no order between
+      // them and another device's bus events, so they cannot share a stream.
+      if (info.devices[j].stream == d.stream &&
+          (info.devices[j].kind == DeviceKind::kVideo) != (d.kind == DeviceKind::kVideo)) {
+        set_error(error, where + ": stream '" + info.streams[static_cast<std::size_t>(d.stream)] +
+                             "' has video and non-video devices (device " + std::to_string(j) +
+                             " '" + info.devices[j].name + "'); a camera needs a stream of its own");
         return false;
       }
     }
@@ -218,7 +230,7 @@ bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::
   info.streams = m.streams;
   for (int i = 0; i < m.num_devices; ++i) {
     const auto idx = static_cast<std::size_t>(i);
-    if (m.device_kinds[idx] < 0 || m.device_kinds[idx] > static_cast<std::int8_t>(DeviceKind::kClock)) {
+    if (m.device_kinds[idx] < 0 || m.device_kinds[idx] > static_cast<std::int8_t>(DeviceKind::kVideo)) {
       set_error(error, "recording_info_t: device " + std::to_string(i) + " has unknown kind " +
                            std::to_string(m.device_kinds[idx]));
       return false;
@@ -238,6 +250,7 @@ struct HalRecordCodec::Messages {
   rtfuse::hal_i2c_t i2c;
   rtfuse::hal_gpio_t gpio;
   rtfuse::hal_clock_t clock;
+  rtfuse::hal_video_t video;
   rtfuse::loop_tick_t tick;
 };
 
@@ -248,7 +261,8 @@ HalRecordCodec::HalRecordCodec(std::vector<RecordedDevice> devices)
   msgs_->can.frames.reserve(hal::kBusEventMaxFrames);
   msgs_->i2c.data.reserve(hal::kBusEventMaxBytes);
   msgs_->tick.consumed.reserve(kMaxTickSensors);
-  for (std::string* s : {&msgs_->can.device, &msgs_->i2c.device, &msgs_->gpio.device, &msgs_->clock.device}) {
+  for (std::string* s :
+       {&msgs_->can.device, &msgs_->i2c.device, &msgs_->gpio.device, &msgs_->clock.device, &msgs_->video.device}) {
     s->reserve(kMaxDeviceNameLength);
   }
 }
@@ -347,6 +361,7 @@ int HalRecordCodec::encode(const BusEvent& ev, std::uint8_t* buf, int capacity) 
       m.lost_before = lost;
       return encode_into(m, buf, capacity);
     }
+    case DeviceKind::kVideo: return -1;  // records() said no already
   }
   return -1;
 }
@@ -478,8 +493,163 @@ bool HalRecordCodec::decode(std::string_view channel, const void* data, int size
       ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
       break;
     }
+    case DeviceKind::kVideo:
+      set_error(error, "channel " + std::string(channel) + " is a video device's: its records are hal_video_t");
+      return false;
   }
   *out = ev;
+  return true;
+}
+
+bool HalRecordCodec::kind_of(int device, DeviceKind* kind) const noexcept {
+  if (device < 0 || static_cast<std::size_t>(device) >= devices_.size()) return false;
+  if (kind != nullptr) *kind = devices_[static_cast<std::size_t>(device)].kind;
+  return true;
+}
+
+namespace {
+
+std::int8_t video_call(hal::VideoCallKind k) {
+  switch (k) {
+    case hal::VideoCallKind::kDequeue: return rtfuse::hal_video_t::DEQUEUE;
+    case hal::VideoCallKind::kRelease: return rtfuse::hal_video_t::RELEASE;
+    case hal::VideoCallKind::kStart: return rtfuse::hal_video_t::START;
+    case hal::VideoCallKind::kStop: return rtfuse::hal_video_t::STOP;
+    case hal::VideoCallKind::kReopen: return rtfuse::hal_video_t::REOPEN;
+    case hal::VideoCallKind::kNone: break;
+  }
+  return -1;
+}
+
+bool in_u32(std::int64_t v) { return v >= 0 && v <= std::numeric_limits<std::uint32_t>::max(); }
+
+}  // namespace
+
+int HalRecordCodec::encode_video(const hal::VideoEvent& ev, const std::uint8_t* data, std::uint8_t* buf,
+                                 int capacity) {
+  if (ev.device >= devices_.size() || devices_[ev.device].kind != DeviceKind::kVideo) return -1;
+  const std::int8_t call = video_call(ev.kind);
+  if (call < 0) return -1;
+  const bool frame = ev.has_frame();
+  if (frame && ev.data_size > 0 && data == nullptr) return -1;
+  // A frame never fits an int-sized LCM message past 2 GB; nothing real comes close.
+  if (ev.data_size > static_cast<std::uint32_t>(std::numeric_limits<std::int32_t>::max() - kVideoRecordOverhead)) {
+    return -1;
+  }
+  rtfuse::hal_video_t& m = msgs_->video;
+  m.utime = ns_to_utime(ev.time_ns);
+  m.time_ns = ev.time_ns;
+  m.device = devices_[ev.device].name;
+  m.call = call;
+  m.status = static_cast<std::int8_t>(ev.status);
+  m.timeout_ns = ev.timeout_ns;
+  m.buffer_index = ev.index;
+  m.stamp_ns = ev.stamp;
+  m.sequence = ev.sequence;
+  m.bytes_used = ev.bytes_used;
+  m.buffer_length = ev.length;
+  m.corrupted = ev.corrupted != 0;
+  m.frame_number = ev.frames_before;
+  m.lost_before = static_cast<std::int32_t>(std::min<std::uint32_t>(ev.lost_before, 0x7FFFFFFF));
+  m.pixel_format = ev.pixel_format;
+  m.width = ev.width;
+  m.height = ev.height;
+  m.bytes_per_line = ev.bytes_per_line;
+  m.image_size = ev.image_size;
+  m.fps_numerator = ev.fps_numerator;
+  m.fps_denominator = ev.fps_denominator;
+  m.buffers = ev.buffers;
+  const std::uint32_t n = frame ? ev.data_size : 0;
+  m.num_data = static_cast<std::int32_t>(n);
+  m.data.assign(data, data + n);  // keeps its capacity: allocates until the largest frame was seen
+  return encode_into(m, buf, capacity);
+}
+
+bool HalRecordCodec::decode_video(std::string_view channel, const void* data, int size, hal::VideoEvent* out,
+                                  const std::uint8_t** frame, std::string* error) {
+  constexpr const char* kType = "hal_video_t";
+  if (frame != nullptr) *frame = nullptr;
+  const int device = device_of(channel);
+  if (device < 0) {
+    set_error(error, "channel " + std::string(channel) + " names no device of the recording_info");
+    return false;
+  }
+  const RecordedDevice& dev = devices_[static_cast<std::size_t>(device)];
+  if (dev.kind != DeviceKind::kVideo) {
+    set_error(error, "channel " + std::string(channel) + " is a " + to_string(dev.kind) +
+                         " device's, not a video device's");
+    return false;
+  }
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  const int after_name = b == nullptr ? -1 : after_device_string(b, size);
+  // call .. buffers (see hal_video_t.lcm): 107 bytes to num_data. num_data
+  // must fit in what is left, so a truncated or corrupt frame record is
+  // refused before lcm-gen sizes a vector from it.
+  const int at = after_name < 0 ? -1 : after_name + 107;
+  if (at < 0 || !count_within(b, size, at, size - at - 4)) {
+    set_error(error, "malformed hal_video_t of " + std::to_string(size) +
+                         " bytes: too short, or a frame length past the end of the record (truncated?)");
+    return false;
+  }
+  rtfuse::hal_video_t& m = msgs_->video;
+  if (!decode_message(m, data, size, kType, error)) return false;
+  if (m.device != dev.name) {
+    set_error(error, std::string(kType) + " names device '" + m.device + "' on the channel of '" + dev.name + "'");
+    return false;
+  }
+  if (!valid_status(m.status)) return bad_field(error, kType, "status", m.status);
+  hal::VideoEvent ev;
+  switch (m.call) {
+    case rtfuse::hal_video_t::DEQUEUE: ev.kind = hal::VideoCallKind::kDequeue; break;
+    case rtfuse::hal_video_t::RELEASE: ev.kind = hal::VideoCallKind::kRelease; break;
+    case rtfuse::hal_video_t::START: ev.kind = hal::VideoCallKind::kStart; break;
+    case rtfuse::hal_video_t::STOP: ev.kind = hal::VideoCallKind::kStop; break;
+    case rtfuse::hal_video_t::REOPEN: ev.kind = hal::VideoCallKind::kReopen; break;
+    default: return bad_field(error, kType, "call", m.call);
+  }
+  ev.device = static_cast<std::uint8_t>(device);
+  ev.status = static_cast<HalStatus>(m.status);
+  const bool has_frame = ev.has_frame();
+  if (has_frame) {
+    if (m.buffer_index < 0 || m.buffer_index >= hal::kMaxVideoBuffers) {
+      return bad_field(error, kType, "buffer index", m.buffer_index);
+    }
+    if (!in_u32(m.sequence)) return bad_field(error, kType, "sequence", m.sequence);
+    if (!in_u32(m.bytes_used)) return bad_field(error, kType, "bytes_used", m.bytes_used);
+    if (!in_u32(m.buffer_length)) return bad_field(error, kType, "buffer_length", m.buffer_length);
+    if (m.num_data > std::min(m.bytes_used, m.buffer_length)) {
+      return bad_field(error, kType, "frame byte count (above bytes_used or the buffer)", m.num_data);
+    }
+  } else if (m.num_data != 0 || m.bytes_used != 0 || m.buffer_length != 0 || m.sequence != 0 || m.stamp_ns != 0 ||
+             m.corrupted) {
+    return bad_field(error, kType, "frame field on a call that returned no frame; frame bytes", m.num_data);
+  }
+  if (m.frame_number < 0) return bad_field(error, kType, "frame_number", m.frame_number);
+  if (m.lost_before < 0) return bad_field(error, kType, "lost_before", m.lost_before);
+  if (!in_u32(m.pixel_format) || !in_u32(m.image_size) || !in_u32(m.fps_numerator) || !in_u32(m.fps_denominator)) {
+    return bad_field(error, kType, "format field (pixel format, image size or rate)", m.pixel_format);
+  }
+  ev.time_ns = m.time_ns;
+  ev.timeout_ns = m.timeout_ns;
+  ev.index = m.buffer_index;
+  ev.stamp = m.stamp_ns;
+  ev.sequence = static_cast<std::uint32_t>(m.sequence);
+  ev.bytes_used = static_cast<std::uint32_t>(m.bytes_used);
+  ev.length = static_cast<std::uint32_t>(m.buffer_length);
+  ev.data_size = static_cast<std::uint32_t>(m.num_data);
+  ev.corrupted = m.corrupted ? 1 : 0;
+  ev.frames_before = m.frame_number;
+  ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
+  ev.pixel_format = static_cast<std::uint32_t>(m.pixel_format);
+  ev.width = m.width;
+  ev.height = m.height;
+  ev.bytes_per_line = m.bytes_per_line;
+  ev.image_size = static_cast<std::uint32_t>(m.image_size);
+  ev.fps_numerator = static_cast<std::uint32_t>(m.fps_numerator);
+  ev.fps_denominator = static_cast<std::uint32_t>(m.fps_denominator);
+  ev.buffers = m.buffers;
+  *out = ev;
+  if (frame != nullptr && has_frame && m.num_data > 0) *frame = m.data.data();
   return true;
 }
 
@@ -556,10 +726,12 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
   HalRecordCodec codec(rec.info.devices);
   for (const std::string& name : rec.info.streams) {
     rec.streams.push_back(std::make_unique<hal::replay::ReplayStream>(name));
+    rec.videos.push_back(std::make_unique<hal::replay::ReplayVideoLog>(name));
   }
   for (std::size_t i = 0; i < rec.info.devices.size(); ++i) {
     const RecordedDevice& d = rec.info.devices[i];
     for (auto& s : rec.streams) s->set_device_name(static_cast<std::uint8_t>(i), d.name);
+    for (auto& v : rec.videos) v->set_device_name(static_cast<std::uint8_t>(i), d.name);
   }
   std::vector<bool> holed(rec.streams.size(), false);
   bool have_tick = false;
@@ -594,7 +766,33 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
     }
     ++rec.events;
     const int size = static_cast<int>(ev.size);
-    if (starts_with(ev.channel, kHalChannelPrefix)) {
+    DeviceKind kind = DeviceKind::kCan;
+    if (starts_with(ev.channel, kHalChannelPrefix) && codec.kind_of(codec.device_of(ev.channel), &kind) &&
+        kind == DeviceKind::kVideo) {
+      hal::VideoEvent video;
+      const std::uint8_t* frame = nullptr;
+      if (!codec.decode_video(ev.channel, ev.data, size, &video, &frame, &why)) return undecodable(ev, why);
+      const auto stream = static_cast<std::size_t>(rec.info.devices[video.device].stream);
+      if (holed[stream]) continue;
+      hal::replay::ReplayVideoLog& log = *rec.videos[stream];
+      if (video.lost_before > 0) {
+        // As for bus events: the lost calls are unknown, the stream ends here.
+        holed[stream] = true;
+        log.mark_hole(ev.event_number, video.lost_before, video.frames_before);
+        rec.lost_events += video.lost_before;
+        rec.lost_frames += log.lost_frames();
+        std::string what = std::to_string(video.lost_before) + " calls";
+        if (log.lost_frames() > 0) {
+          what += " (frames " + std::to_string(log.first_lost_frame()) + ".." +
+                  std::to_string(log.first_lost_frame() + log.lost_frames() - 1) + ")";
+        }
+        rec.warnings.push_back("stream '" + rec.info.streams[stream] + "': the recorder lost " + what +
+                               " before event " + std::to_string(ev.event_number) +
+                               " (its ring was full): this stream replays only up to there");
+        continue;
+      }
+      log.append(video, frame, ev.event_number);
+    } else if (starts_with(ev.channel, kHalChannelPrefix)) {
       BusEvent bus;
       if (!codec.decode(ev.channel, ev.data, size, &bus, &why)) return undecodable(ev, why);
       const auto stream = static_cast<std::size_t>(rec.info.devices[bus.device].stream);

@@ -6,7 +6,8 @@
 // on rtfuse/rec/info (format version, config, the device table: name, kind
 // and producing thread of every recorded bus). Then, in whatever order the
 // recorder drained its rings: one hal_can_t / hal_i2c_t / hal_gpio_t /
-// hal_clock_t per bus call on rtfuse/hal/<device name>, one loop_tick_t per
+// hal_clock_t per bus call, one hal_video_t per camera call (with the frame
+// bytes of a dequeue) on rtfuse/hal/<device name>, one loop_tick_t per
 // loop tick on rtfuse/rec/tick, and the published outputs on their own
 // channels. Events of one thread (stream) are in call order.
 //
@@ -23,6 +24,8 @@
 #include "core/time.hpp"
 #include "hal/bus_event.hpp"
 #include "hal/replay/replay_stream.hpp"
+#include "hal/replay/replay_video_stream.hpp"
+#include "hal/video_event.hpp"
 #include "transport/event_log.hpp"
 
 namespace rtfuse::transport {
@@ -42,10 +45,17 @@ constexpr int kMaxTickSensors = 64;
 // Largest encoded bus event (a receive of 16 frames on a 48-character device
 // name is under 500 bytes).
 constexpr int kMaxHalRecordSize = 1024;
+// A hal_video_t is its frame bytes plus at most this much (fields and a
+// 48-character device name): size the encode buffer slot_bytes + this.
+constexpr int kVideoRecordOverhead = 256;
 
-enum class DeviceKind : std::uint8_t { kCan, kI2c, kGpioEdge, kGpioOutput, kClock };
+// Stored as recording_info_t.device_kinds (DEVICE_*): append only.
+// kVideo records hal_video_t (hal::VideoEvent), not BusEvents, through its
+// own ring, so a video device's stream holds no other device (the order of
+// two rings is not kept in the log).
+enum class DeviceKind : std::uint8_t { kCan, kI2c, kGpioEdge, kGpioOutput, kClock, kVideo };
 const char* to_string(DeviceKind k) noexcept;
-// The bus call kinds a device of this kind records.
+// The bus call kinds a device of this kind records (none for kVideo).
 bool records(DeviceKind device, hal::BusEventKind call) noexcept;
 
 struct RecordedDevice {
@@ -69,7 +79,8 @@ struct RecordingInfo {
 std::int64_t config_text_hash(std::string_view text) noexcept;
 
 // Device names non-empty, at most kMaxDeviceNameLength, unique, without '/'
-// or spaces; stream indices valid; counts within the limits above.
+// or spaces; stream indices valid; counts within the limits above; a video
+// device's stream holds only video devices.
 bool validate(const RecordingInfo& info, std::string* error);
 
 std::vector<std::uint8_t> encode_recording_info(const RecordingInfo& info);
@@ -109,6 +120,19 @@ class HalRecordCodec {
                   int capacity);
   static bool decode_tick(const void* data, int size, LoopTick* out, std::string* error);
 
+  // hal_video_t of a video device: ev and, when ev.has_frame(), its
+  // ev.data_size bytes at data. Bytes written or -1 (unknown device, not a
+  // video device, capacity too small: data_size + kVideoRecordOverhead fits).
+  int encode_video(const hal::VideoEvent& ev, const std::uint8_t* data, std::uint8_t* buf, int capacity);
+  // The hal_video_t on `channel` into *out; *frame points at its
+  // out->data_size frame bytes (inside this codec, valid until the next
+  // decode_video; null without a frame). False with a reason on a wrong
+  // type, a bad or truncated length, or an impossible value.
+  bool decode_video(std::string_view channel, const void* data, int size, hal::VideoEvent* out,
+                    const std::uint8_t** frame, std::string* error);
+  // Kind of a device index; false for an index outside the table.
+  bool kind_of(int device, DeviceKind* kind) const noexcept;
+
  private:
   struct Messages;  // the lcm-gen types stay out of this header
   std::vector<RecordedDevice> devices_;
@@ -129,11 +153,15 @@ struct HalRecording {
   RecordingInfo info;
   // One per info.streams entry, in that order, with every device's name set.
   std::vector<std::unique_ptr<hal::replay::ReplayStream>> streams;
+  // One per info.streams entry too: the recorded camera calls of that stream
+  // (empty for a stream without a video device), frames in memory.
+  std::vector<std::unique_ptr<hal::replay::ReplayVideoLog>> videos;
   std::vector<LoopTick> ticks;
   std::vector<RecordedOutput> outputs;
   std::int64_t events = 0;         // log events loaded
   bool truncated = false;          // the log ends mid-event (loaded with allow_truncated)
-  std::int64_t lost_events = 0;    // bus events the recorder had no room for
+  std::int64_t lost_events = 0;    // bus events and video calls the recorder had no room for
+  std::int64_t lost_frames = 0;    // camera frames among them
   std::int64_t missing_ticks = 0;  // gaps in the tick sequence
   std::vector<std::string> warnings;  // one line each: truncation, holes, missing ticks
 };

@@ -1,0 +1,237 @@
+#include "hal/replay/replay_video_stream.hpp"
+
+#include <algorithm>
+#include <cstdarg>
+#include <cstdio>
+#include <cstring>
+#include <utility>
+
+namespace rtfuse::hal::replay {
+namespace {
+
+// Same kind of call on the same device with the same arguments.
+bool same_call(const VideoEvent& rec, const VideoEvent& call) {
+  if (rec.kind != call.kind || rec.device != call.device) return false;
+  switch (rec.kind) {
+    case VideoCallKind::kDequeue: return rec.timeout_ns == call.timeout_ns;
+    case VideoCallKind::kRelease: return rec.index == call.index;
+    case VideoCallKind::kStart:
+    case VideoCallKind::kStop:
+    case VideoCallKind::kReopen:
+    case VideoCallKind::kNone: return true;
+  }
+  return false;
+}
+
+// snprintf into a fixed buffer, never past its end.
+class Text {
+ public:
+  Text(char* buf, std::size_t size) : buf_(buf), size_(size) {
+    if (size_ > 0) buf_[0] = '\0';
+  }
+  __attribute__((format(printf, 2, 3))) void add(const char* fmt, ...) {
+    if (pos_ + 1 >= size_) return;
+    va_list args;
+    va_start(args, fmt);
+    const int n = std::vsnprintf(buf_ + pos_, size_ - pos_, fmt, args);
+    va_end(args);
+    if (n > 0) pos_ = std::min(size_ - 1, pos_ + static_cast<std::size_t>(n));
+  }
+  int length() const { return static_cast<int>(pos_); }
+
+ private:
+  char* buf_;
+  std::size_t size_;
+  std::size_t pos_ = 0;
+};
+
+}  // namespace
+
+ReplayVideoLog::ReplayVideoLog(std::string name) : name_(std::move(name)) {}
+
+void ReplayVideoLog::append(const VideoEvent& ev, const std::uint8_t* data, std::int64_t log_event) {
+  Call c{ev, log_event, bytes_.size()};
+  if (ev.has_frame()) {
+    // Zero-padded to the buffer's capacity: a driver may look past bytes_used
+    // (a short frame) without reading outside the loaded recording.
+    const std::size_t keep = std::max<std::size_t>(ev.data_size, ev.length);
+    bytes_.resize(bytes_.size() + keep, 0);
+    if (data != nullptr && ev.data_size > 0) std::memcpy(bytes_.data() + c.offset, data, ev.data_size);
+    ++frames_;
+  }
+  calls_.push_back(c);
+}
+
+void ReplayVideoLog::mark_hole(std::int64_t log_event, std::uint32_t lost, std::int64_t next_frames_before) {
+  if (hole_lost_ > 0) return;  // only the first hole matters: the replay stops there
+  hole_event_ = log_event;
+  hole_lost_ = lost;
+  std::int64_t next_frame = 0;
+  if (!calls_.empty()) {
+    const VideoEvent& last = calls_.back().ev;
+    next_frame = last.frames_before + (last.has_frame() ? 1 : 0);
+  }
+  hole_first_frame_ = next_frame;
+  hole_frames_ = std::max<std::int64_t>(0, next_frames_before - next_frame);
+}
+
+void ReplayVideoLog::set_device_name(std::uint8_t device, std::string name) {
+  if (device_names_.size() <= device) device_names_.resize(static_cast<std::size_t>(device) + 1);
+  device_names_[device] = std::move(name);
+}
+
+const std::uint8_t* ReplayVideoLog::data(std::size_t i) const noexcept {
+  if (i >= calls_.size() || !calls_[i].ev.has_frame()) return nullptr;
+  return bytes_.data() + calls_[i].offset;
+}
+
+const VideoEvent* ReplayVideoLog::take(const VideoEvent& call, const std::uint8_t** frame) noexcept {
+  if (frame != nullptr) *frame = nullptr;
+  if (diverged()) return nullptr;
+  const std::size_t pos = position_.load(std::memory_order_relaxed);
+  if (pos >= calls_.size()) {
+    diverge(DivergenceKind::kEndOfStream, calls_.empty() ? -1 : calls_.back().log_event, nullptr, call);
+    return nullptr;
+  }
+  const Call& c = calls_[pos];
+  if (!same_call(c.ev, call)) {
+    diverge(DivergenceKind::kMismatch, c.log_event, &c.ev, call);
+    return nullptr;
+  }
+  if (frame != nullptr) *frame = data(pos);
+  position_.store(pos + 1, std::memory_order_release);
+  return &c.ev;
+}
+
+int ReplayVideoLog::describe(char* buf, std::size_t size, const VideoEvent& ev, bool attempted,
+                             bool with_device) const noexcept {
+  Text t(buf, size);
+  t.add(attempted ? "called %s" : "%s", to_string(ev.kind));
+  if (with_device) {
+    if (ev.device < device_names_.size() && !device_names_[ev.device].empty()) {
+      t.add(" on %s", device_names_[ev.device].c_str());
+    } else {
+      t.add(" on device %u", static_cast<unsigned>(ev.device));
+    }
+  }
+  if (ev.kind == VideoCallKind::kDequeue) t.add(" timeout %lld ns", static_cast<long long>(ev.timeout_ns));
+  if (ev.kind == VideoCallKind::kRelease) t.add(" index %d", ev.index);
+  return t.length();
+}
+
+void ReplayVideoLog::diverge(DivergenceKind kind, std::int64_t log_event, const VideoEvent* recorded,
+                             const VideoEvent& call) noexcept {
+  char attempted[160];
+  Text t(report_, sizeof report_);
+  if (kind == DivergenceKind::kMismatch && recorded != nullptr) {
+    const bool other_device = recorded->device != call.device;
+    char rec[160];
+    describe(rec, sizeof rec, *recorded, false, other_device);
+    describe(attempted, sizeof attempted, call, true, other_device);
+    t.add("event %lld: recorded %s, driver %s", static_cast<long long>(log_event), rec, attempted);
+  } else {
+    describe(attempted, sizeof attempted, call, true, true);
+    const auto replayed = static_cast<unsigned long long>(calls_.size());
+    if (hole_lost_ > 0 && hole_frames_ > 0) {
+      t.add("stream '%s' ends at event %lld: frame %lld of stream %s was not recorded: the recorder's ring "
+            "was full (%lld frames, %u calls lost; %llu calls replayed): driver %s",
+            name_.c_str(), static_cast<long long>(hole_event_), static_cast<long long>(hole_first_frame_),
+            name_.c_str(), static_cast<long long>(hole_frames_), hole_lost_, replayed, attempted);
+    } else if (hole_lost_ > 0) {
+      t.add("stream '%s' ends at event %lld, where the recorder lost %u calls (no frame among them; its ring "
+            "was full while recording; %llu calls replayed): driver %s",
+            name_.c_str(), static_cast<long long>(hole_event_), hole_lost_, replayed, attempted);
+    } else if (calls_.empty()) {
+      t.add("stream '%s' has no recorded video calls: driver %s", name_.c_str(), attempted);
+    } else {
+      t.add("stream '%s' ended after event %lld (%llu calls replayed): driver %s", name_.c_str(),
+            static_cast<long long>(log_event), replayed, attempted);
+    }
+  }
+  report_event_ = log_event;
+  kind_.store(kind, std::memory_order_release);
+}
+
+// ---------------------------------------------------------------- stream
+
+ReplayVideoStream::ReplayVideoStream(ReplayVideoLog& log, std::uint8_t device) noexcept
+    : log_(log), device_(device) {
+  if (log_.size() > 0) format_ = log_.event(0).format();
+}
+
+const VideoEvent* ReplayVideoStream::take(VideoCallKind kind, TimeNs timeout_ns, int index,
+                                          const std::uint8_t** frame) noexcept {
+  VideoEvent call;
+  call.kind = kind;
+  call.device = device_;
+  call.timeout_ns = timeout_ns;
+  call.index = index;
+  const VideoEvent* rec = log_.take(call, frame);
+  if (rec == nullptr) {
+    last_status_ = HalStatus::kClosed;
+    return nullptr;
+  }
+  last_status_ = rec->status;
+  format_ = rec->format();
+  return rec;
+}
+
+HalStatus ReplayVideoStream::start() noexcept {
+  const VideoEvent* rec = take(VideoCallKind::kStart, 0, -1, nullptr);
+  if (rec != nullptr && rec->status == HalStatus::kOk) tracker_.reset();
+  return last_status_;
+}
+
+void ReplayVideoStream::stop() noexcept { take(VideoCallKind::kStop, 0, -1, nullptr); }
+
+HalStatus ReplayVideoStream::dequeue(TimeNs timeout_ns, VideoFrame* frame) noexcept {
+  const std::uint8_t* data = nullptr;
+  const VideoEvent* rec = take(VideoCallKind::kDequeue, timeout_ns, -1, &data);
+  if (rec == nullptr) return last_status_;
+  switch (rec->status) {
+    case HalStatus::kOk: break;
+    case HalStatus::kTimeout: ++stats_.timeouts; return rec->status;
+    case HalStatus::kClosed: ++stats_.lost; return rec->status;
+    default: return rec->status;
+  }
+  ++stats_.frames;
+  const std::uint32_t gap = tracker_.observe(rec->sequence);
+  if (gap > 0) {
+    stats_.dropped += gap;
+    ++stats_.sequence_gaps;
+  }
+  if (rec->corrupted != 0) ++stats_.corrupted;
+  if (frame != nullptr) {
+    frame->index = rec->index;
+    frame->data = data;
+    frame->bytes_used = rec->bytes_used;
+    frame->length = rec->length;
+    frame->stamp = rec->stamp;
+    frame->sequence = rec->sequence;
+    frame->corrupted = rec->corrupted != 0;
+  }
+  return rec->status;
+}
+
+HalStatus ReplayVideoStream::release(int index) noexcept {
+  take(VideoCallKind::kRelease, 0, index, nullptr);
+  return last_status_;
+}
+
+HalStatus ReplayVideoStream::reopen() noexcept {
+  const VideoEvent* rec = take(VideoCallKind::kReopen, 0, -1, nullptr);
+  if (rec == nullptr) return last_status_;
+  if (rec->status == HalStatus::kOk) {
+    ++stats_.reopens;
+    tracker_.reset();
+  } else {
+    ++stats_.reopen_failures;
+  }
+  return rec->status;
+}
+
+const char* ReplayVideoStream::last_error() const noexcept {
+  return log_.diverged() ? log_.divergence() : to_string(last_status_);
+}
+
+}  // namespace rtfuse::hal::replay

@@ -1,0 +1,49 @@
+#pragma once
+// The simulated robot's stereo camera: a mock video stream whose frames are
+// rendered, when the camera thread dequeues them, from the ground-truth pose
+// at their capture time through the configured mount (base_link -> the
+// camera's optical frame) and calibration, distortion included. The same
+// camera driver runs on it as on a real camera.
+#include <cstdint>
+#include <memory>
+#include <string>
+
+#include "drivers/camera/stereo_calibration.hpp"
+#include "geometry/rigid_transform.hpp"
+#include "hal/clock.hpp"
+#include "hal/mock/frame_source.hpp"
+#include "hal/mock/mock_video_stream.hpp"
+#include "runtime/config.hpp"
+#include "sim/camera_world.hpp"
+#include "sim/stereo_renderer.hpp"
+#include "sim/truth_trajectory.hpp"
+
+namespace rtfuse::sim {
+
+class SimCamera final : public hal::mock::FrameSource {
+ public:
+  // The camera section's calibration file and mode, the mount from the
+  // config's static transforms. Null with *error when they do not fit.
+  static std::unique_ptr<SimCamera> create(const RuntimeConfig& cfg, const TruthTrajectory& truth, hal::Clock& clock,
+                                           TimeNs t0, std::uint64_t seed, std::string* error);
+
+  hal::VideoStream& stream() { return *stream_; }
+  // Capture time of the next frame: what the lockstep drive steps the camera thread up to.
+  TimeNs next_frame_time() noexcept override { return next_; }
+  std::uint32_t fill(TimeNs stamp, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override;
+
+ private:
+  SimCamera() = default;
+
+  const TruthTrajectory* truth_ = nullptr;
+  TimeNs t0_ = 0;
+  TimeNs period_ = 0;
+  TimeNs next_ = 0;
+  geometry::RigidTransform base_T_camera_;
+  hal::VideoFormat format_;
+  std::unique_ptr<CameraWorld> world_;
+  std::unique_ptr<StereoRenderer> renderer_;
+  std::unique_ptr<hal::mock::MockVideoStream> stream_;
+};
+
+}  // namespace rtfuse::sim
