@@ -36,6 +36,10 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
   if (!rt->pipeline_) return nullptr;
   FusionCore& core = rt->pipeline_->core();
   const RuntimeConfig& c = core.config();
+  if (rt->pipeline_->hardware() != nullptr && rt->pipeline_->hardware()->camera() != nullptr) {
+    rt->camera_outputs_ = CameraOutputs::create(*rt->pipeline_->hardware()->camera(), c.hardware.camera, error);
+    if (!rt->camera_outputs_) return nullptr;
+  }
   for (int i = 0; i < c.num_sensors; ++i) {
     if (c.sensors[i].source != SensorSource::kLcm) continue;
     if (!rt->lcm_->subscribe(c.sensors[i].channel.c_str(), &Runtime::on_lcm, &core)) {
@@ -153,6 +157,9 @@ void Runtime::publisher_thread() {
       publish_jobs_.pop();
     }
     if (!running) break;  // the loop has stopped: everything it queued is out
+    // Not recorded: a preview is for watching, and far larger than a
+    // recorded output may be; the recording has the frames themselves.
+    if (camera_outputs_) camera_outputs_->publish_due(monotonic_now_ns(), *lcm_sink_);
     next += period;
     sleep_until(next);
   }

@@ -17,6 +17,7 @@
 
 #include "core/spsc_ring.hpp"
 #include "hal/linux/monotonic_clock.hpp"
+#include "runtime/camera_outputs.hpp"
 #include "runtime/hal_buses.hpp"
 #include "runtime/tick_pipeline.hpp"
 #include "transport/lcm_node.hpp"
@@ -83,6 +84,7 @@ class Runtime {
   std::unique_ptr<transport::LcmNode> lcm_;
   std::unique_ptr<MessageSink> lcm_sink_;
   std::unique_ptr<TickPipeline> pipeline_;
+  std::unique_ptr<CameraOutputs> camera_outputs_;  // with a camera: info and preview
   QueuedOutput queued_output_{*this};
   hal::MonotonicClock clock_;
   // Snapshots are large: a few slots cover the publisher thread waking late.

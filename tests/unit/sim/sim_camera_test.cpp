@@ -9,8 +9,16 @@
 #include <unistd.h>
 
 #include <cstdio>
+#include <cstring>
 
+#include "hal/mock/sim_clock.hpp"
+#include "rtfuse/camera_info_t.hpp"
+#include "rtfuse/image_t.hpp"
+#include "runtime/camera_outputs.hpp"
 #include "runtime/config_loader.hpp"
+#include "runtime/tick_pipeline.hpp"
+#include "sim/simulated_robot.hpp"
+#include "support/alloc_counter.hpp"
 #include "runtime/device_layout.hpp"
 #include "runtime/hal_replay.hpp"
 #include "sim/simulated_drive.hpp"
@@ -128,6 +136,98 @@ TEST(SimCamera, RecordedFramesReplayThroughTheDriver) {
   EXPECT_EQ(value(*replayed, "frames"), value(*live, "frames"));
   EXPECT_GT(value(*replayed, "frames"), 500);
   EXPECT_EQ(value(*replayed, "rejected_size"), 0);
+}
+
+// Keeps the last message of each camera channel; allocates nothing while
+// publishing (its buffers are reserved), so the test can count the outputs'.
+class CapturingSink final : public MessageSink {
+ public:
+  CapturingSink() {
+    preview.reserve(1 << 20);
+    left.reserve(1 << 12);
+    right.reserve(1 << 12);
+  }
+  bool publish(const char* channel, const std::uint8_t* data, int size, TimeNs) override {
+    if (std::strcmp(channel, "rtfuse/camera/preview") == 0) preview.assign(data, data + size);
+    if (std::strcmp(channel, "rtfuse/camera/info/left") == 0) left.assign(data, data + size);
+    if (std::strcmp(channel, "rtfuse/camera/info/right") == 0) right.assign(data, data + size);
+    ++messages;
+    return true;
+  }
+  std::vector<std::uint8_t> preview, left, right;
+  int messages = 0;
+};
+
+class NullSink final : public MessageSink {
+ public:
+  bool publish(const char*, const std::uint8_t*, int, TimeNs) override { return true; }
+};
+
+// The daemon's camera outputs: the newest rectified pair as a half-size
+// side-by-side preview and each eye's rectified camera info, at the preview
+// rate, from the frame pool by handle.
+TEST(SimCamera, PreviewAndCameraInfoOfTheNewestPair) {
+  const ConfigLoadResult r = load(kCamera);
+  ASSERT_TRUE(r.config) << errors(r);
+  const TimeNs t0 = 1'000'000'000;
+  hal::mock::SimClock clock(t0);
+  std::string err;
+  auto robot = sim::SimulatedRobot::create(*r.config, std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml",
+                                           clock, t0, &err);
+  ASSERT_TRUE(robot) << err;
+  NullSink null_sink;
+  PipelineOptions options;
+  options.sink = &null_sink;
+  auto pipeline = TickPipeline::create(*r.config, robot->buses(), options, &err);
+  ASSERT_TRUE(pipeline) << err;
+  ASSERT_TRUE(pipeline->start(t0, &err)) << err;
+  CameraDevice* camera = pipeline->hardware()->camera();
+  ASSERT_NE(camera, nullptr);
+  auto outputs = CameraOutputs::create(*camera, r.config->hardware.camera, &err);
+  ASSERT_TRUE(outputs) << err;
+  CapturingSink sink;
+  // No pair yet: nothing to show.
+  outputs->publish_due(t0, sink);
+  EXPECT_EQ(sink.messages, 0);
+  for (int i = 0; i < 3; ++i) camera->step(kDeviceStepTimeoutNs);
+  ASSERT_EQ(camera->samples(), 3);
+  std::size_t allocations = 0;
+  {
+    test::AllocScope allocs;
+    outputs->publish_due(clock.now(), sink);
+    allocations = allocs.count();
+  }
+  EXPECT_EQ(allocations, 0u);
+  ASSERT_EQ(sink.messages, 3);
+  rtfuse::image_t image;
+  ASSERT_GT(image.decode(sink.preview.data(), 0, static_cast<int>(sink.preview.size())), 0);
+  EXPECT_EQ(image.encoding, "mono8");
+  EXPECT_EQ(image.width, 672);   // two VGA eyes at half size
+  EXPECT_EQ(image.height, 188);
+  EXPECT_EQ(image.header.frame_id, "camera_optical");
+  // The third frame's capture time: three periods after the start.
+  EXPECT_NEAR(static_cast<double>(image.header.utime), static_cast<double>((t0 + 3 * 33'333'333) / 1000), 1.0);
+  // A rendered scene, not a blank or saturated picture.
+  double sum = 0.0;
+  for (std::uint8_t v : image.data) sum += v;
+  const double mean = sum / static_cast<double>(image.data.size());
+  EXPECT_GT(mean, 30.0);
+  EXPECT_LT(mean, 230.0);
+  rtfuse::camera_info_t left, right;
+  ASSERT_GT(left.decode(sink.left.data(), 0, static_cast<int>(sink.left.size())), 0);
+  ASSERT_GT(right.decode(sink.right.data(), 0, static_cast<int>(sink.right.size())), 0);
+  const drivers::StereoRectification& rect = camera->rectified();
+  EXPECT_EQ(left.width, 672);
+  EXPECT_EQ(left.height, 376);
+  EXPECT_DOUBLE_EQ(left.K[0], rect.fx);
+  EXPECT_DOUBLE_EQ(left.P[3], 0.0);
+  EXPECT_DOUBLE_EQ(right.P[3], -rect.fx * rect.baseline_m);
+  EXPECT_NEAR(rect.baseline_m, 0.120, 0.001);  // the calibration file's 119.997 mm
+  // Not again until the next period, and not for the same pair.
+  outputs->publish_due(clock.now() + 500'000'000, sink);
+  EXPECT_EQ(sink.messages, 3);
+  outputs->publish_due(clock.now() + 1'000'000'000, sink);
+  EXPECT_EQ(sink.messages, 3) << "no new pair since the last preview";
 }
 
 TEST(SimCamera, CameraWithoutMountIsRefusedNamingTheFrame) {
