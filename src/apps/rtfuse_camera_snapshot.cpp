@@ -47,13 +47,7 @@ int main(int argc, char** argv) {
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
   }
-  std::string text;
-  int err = 0;
-  if (!rtfuse::read_text_file(config_path, &text, &err)) {
-    std::fprintf(stderr, "rtfuse-camera-snapshot: cannot read %s: %s\n", config_path.c_str(), std::strerror(err));
-    return 2;
-  }
-  const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(text, config_path);
+  const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_file(config_path);
   if (!loaded.config) {
     for (const auto& e : loaded.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
     return 2;
