@@ -16,26 +16,22 @@
 //   ioctl then fails with ENODEV and open() too, but the /dev node stays.
 //   When the last file handle on the instance closes, vivid registers the
 //   nodes again ("reconnect"), so a reopen after everyone let go recovers.
-#include <dirent.h>
-#include <fcntl.h>
 #include <gtest/gtest.h>
-#include <linux/v4l2-dv-timings.h>
-#include <linux/videodev2.h>
-#include <sys/ioctl.h>
 #include <unistd.h>
 
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
 #include <cstdint>
+#include <cstdio>
 #include <cstring>
-#include <fstream>
 #include <memory>
 #include <string>
 #include <thread>
 
 #include "core/time.hpp"
 #include "hal/linux/v4l2_stream.hpp"
+#include "vivid_node.hpp"
 
 namespace {
 
@@ -45,6 +41,9 @@ using rtfuse::hal::HalStatus;
 using rtfuse::hal::V4l2Stream;
 using rtfuse::hal::VideoFrame;
 using rtfuse::hal::VideoRequest;
+using rtfuse::kernel_test::find_node;
+using rtfuse::kernel_test::has;
+using rtfuse::kernel_test::RawNode;
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kSecond = 1'000'000'000;
@@ -54,98 +53,6 @@ constexpr TimeNs kFrameWait = 3 * kSecond;
 constexpr int kStereoWidth = 1344;  // two 672x376 eyes side by side (ZED VGA)
 constexpr int kStereoHeight = 376;
 constexpr int kFps = 30;
-
-bool has(const std::string& s, const std::string& part) { return s.find(part) != std::string::npos; }
-
-std::string errno_text(int err) { return std::string(std::strerror(err)) + " (errno " + std::to_string(err) + ")"; }
-
-// /dev/videoN of the node whose /sys/class/video4linux/*/name is `name`
-// (vivid names them "vivid-000-vid-cap"); empty if there is none.
-std::string find_node(const std::string& name) {
-  DIR* dir = opendir("/sys/class/video4linux");
-  if (dir == nullptr) return {};
-  std::string found;
-  while (dirent* e = readdir(dir)) {
-    if (e->d_name[0] == '.') continue;
-    std::ifstream in(std::string("/sys/class/video4linux/") + e->d_name + "/name");
-    std::string line;
-    if (std::getline(in, line) && line == name) {
-      found = std::string("/dev/") + e->d_name;
-      break;
-    }
-  }
-  closedir(dir);
-  return found;
-}
-
-// A raw file handle on a node, for what the stream does not do itself
-// (choosing the input, pressing a control).
-class RawNode {
- public:
-  explicit RawNode(const std::string& path) : path_(path), fd_(::open(path.c_str(), O_RDWR | O_CLOEXEC)) {
-    if (fd_ < 0) error_ = "open " + path + ": " + errno_text(errno);
-  }
-  ~RawNode() { close(); }
-  RawNode(const RawNode&) = delete;
-  RawNode& operator=(const RawNode&) = delete;
-  void close() {
-    if (fd_ >= 0) ::close(fd_);
-    fd_ = -1;
-  }
-  bool ok() const { return fd_ >= 0; }
-  const std::string& error() const { return error_; }
-
-  // Selects the first input whose name starts with `prefix` ("HDMI", "Webcam").
-  bool select_input(const std::string& prefix) {
-    for (std::uint32_t i = 0; i < 16; ++i) {
-      v4l2_input in{};
-      in.index = i;
-      if (::ioctl(fd_, VIDIOC_ENUMINPUT, &in) < 0) break;
-      if (std::string(reinterpret_cast<const char*>(in.name)).rfind(prefix, 0) != 0) continue;
-      int index = static_cast<int>(i);
-      if (::ioctl(fd_, VIDIOC_S_INPUT, &index) < 0) return fail("VIDIOC_S_INPUT " + prefix);
-      return true;
-    }
-    error_ = path_ + " has no input named " + prefix + "*";
-    return false;
-  }
-
-  // 1280x720p30 (CEA-861 VIC 34) on the HDMI input: a 30 fps source.
-  bool set_hdmi_720p30() {
-    v4l2_dv_timings t = V4L2_DV_BT_CEA_1280X720P30;
-    if (::ioctl(fd_, VIDIOC_S_DV_TIMINGS, &t) < 0) return fail("VIDIOC_S_DV_TIMINGS 1280x720p30");
-    return true;
-  }
-
-  // The id of the control named `name` (VIDIOC_QUERY_EXT_CTRL walk); 0 if none.
-  std::uint32_t find_control(const std::string& name) {
-    v4l2_query_ext_ctrl q{};
-    q.id = V4L2_CTRL_FLAG_NEXT_CTRL | V4L2_CTRL_FLAG_NEXT_COMPOUND;
-    while (::ioctl(fd_, VIDIOC_QUERY_EXT_CTRL, &q) == 0) {
-      if (name == q.name) return q.id;
-      q.id |= V4L2_CTRL_FLAG_NEXT_CTRL | V4L2_CTRL_FLAG_NEXT_COMPOUND;
-    }
-    error_ = path_ + " has no control named \"" + name + "\"";
-    return 0;
-  }
-
-  bool press(std::uint32_t id) {
-    v4l2_control c{};
-    c.id = id;
-    c.value = 1;
-    if (::ioctl(fd_, VIDIOC_S_CTRL, &c) < 0) return fail("VIDIOC_S_CTRL (button)");
-    return true;
-  }
-
- private:
-  bool fail(const std::string& what) {
-    error_ = path_ + ": " + what + ": " + errno_text(errno);
-    return false;
-  }
-  std::string path_;
-  int fd_;
-  std::string error_;
-};
 
 VideoRequest stereo_request() {
   VideoRequest r;
