@@ -152,7 +152,6 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   std::unique_ptr<hal::Clock> clock;
   const int camera = stream_index(rec.info, kCameraStream);
   std::unique_ptr<hal::VideoStream> video;
-  hal::replay::ReplayVideoLog* video_log = nullptr;
   FreeRunningClock camera_clock;
   HalBuses buses;
   for (std::size_t d = 0; d < rec.info.devices.size(); ++d) {
@@ -188,8 +187,8 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
       case transport::DeviceKind::kVideo:
         if (dev.stream == camera && !video && static_cast<std::size_t>(dev.stream) < rec.videos.size() &&
             rec.videos[static_cast<std::size_t>(dev.stream)]) {
-          video_log = rec.videos[static_cast<std::size_t>(dev.stream)].get();
-          video = std::make_unique<hal::replay::ReplayVideoStream>(*video_log, index);
+          video = std::make_unique<hal::replay::ReplayVideoStream>(*rec.videos[static_cast<std::size_t>(dev.stream)],
+                                                                   index);
           buses.camera.video = video.get();
           buses.camera.clock = &camera_clock;
         }
@@ -309,23 +308,27 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   // Devices that feed no sensor (the camera, until visual odometry) do not
   // change what a tick publishes: their recorded calls are replayed after
   // the ticks, through the same driver, in their recorded order.
-  if (video_log != nullptr && !result.diverged && !result.ended_early) {
-    for (int d = 0; d < pipeline->thread_device_count(); ++d) {
-      ThreadDevice& device = pipeline->thread_device(d);
-      if (std::string_view(device.name()) != kCameraStream) continue;
-      camera_clock.sleep_until(t0);
-      // Each step makes at least one call unless the driver is backing off,
-      // which the free-running clock ends at the next step: bounded.
-      for (std::size_t k = 0; k < 2 * video_log->size() + 16 && !video_log->diverged() && !video_log->at_end(); ++k) {
-        device.step(kDeviceStepTimeoutNs);
-      }
-      if (video_log->divergence_kind() == hal::replay::DivergenceKind::kMismatch) {
-        result.diverged = true;
-        result.error = std::string("replay diverged from the recording in stream 'camera': ") + video_log->divergence();
-      } else if (video_log->diverged()) {
-        result.ended_early = true;
-        result.note = std::string("the recording of stream 'camera' ends early: ") + video_log->divergence();
-      }
+  for (int d = 0; d < pipeline->thread_device_count() && !result.diverged && !result.ended_early; ++d) {
+    ThreadDevice& device = pipeline->thread_device(d);
+    const int index = stream_index(rec.info, device.name());
+    if (device.sensor() >= 0 || index < 0 || static_cast<std::size_t>(index) >= rec.videos.size() ||
+        !rec.videos[static_cast<std::size_t>(index)]) {
+      continue;
+    }
+    hal::replay::ReplayVideoLog& log = *rec.videos[static_cast<std::size_t>(index)];
+    camera_clock.sleep_until(t0);
+    // Each step makes at least one call unless the driver is backing off,
+    // which the free-running clock ends at the next step: bounded.
+    for (std::size_t k = 0; k < 2 * log.size() + 16 && !log.diverged() && !log.at_end(); ++k) {
+      device.step(kDeviceStepTimeoutNs);
+    }
+    const std::string stream = "stream '" + std::string(device.name()) + "'";
+    if (log.divergence_kind() == hal::replay::DivergenceKind::kMismatch) {
+      result.diverged = true;
+      result.error = "replay diverged from the recording in " + stream + ": " + log.divergence();
+    } else if (log.diverged()) {
+      result.ended_early = true;
+      result.note = "the recording of " + stream + " ends early: " + log.divergence();
     }
   }
   if (progress) progress(prog);
