@@ -340,7 +340,7 @@ def show(title, stamp, d):
     for dev in d.devices:
         values = ", ".join(f"{k} {v}" for k, v in zip(dev.keys, dev.values))
         print(f"  device {dev.name} ({dev.hardware_id}): {LEVEL.get(dev.level, dev.level)} {dev.state}"
-              + (f", {values}" if values else ""))
+              + (f", {values}" if values else "") + (f"; last error: {dev.message}" if dev.message else ""))
 
 
 show(f"first {channel} message", *msgs[0])

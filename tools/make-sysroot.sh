@@ -37,6 +37,8 @@ packages=(
   libgtest-dev libgmock-dev googletest libbenchmark1debian libbenchmark-dev
   # the stereo PNG writer of the snapshot tool (src/apps/stereo_png.cpp)
   libpng16-16 libpng-dev
+  # XXH64, inlined: the header only (src/core/xxh64.hpp)
+  libxxhash-dev
 )
 
 mkdir -p "$dir"

@@ -15,6 +15,8 @@ packages=(
   linux-libc-dev libgpiod-dev
   # the stereo PNG writer of the snapshot tool (src/apps/stereo_png.cpp)
   libpng-dev
+  # XXH64, inlined (the camera's digest of its rectified pairs, src/core/xxh64.hpp)
+  libxxhash-dev
   binutils libc6-dev
   # the aarch64 stage (tools/test-cross.sh): cross compiler, user-mode
   # emulation, and the arm64 package installed in a clean arm64 root

@@ -1,8 +1,11 @@
 #include "drivers/camera/stereo_camera.hpp"
 
 #include <cstdarg>
+#include <cstddef>
 #include <cstdio>
 #include <cstdint>
+
+#include "core/xxh64.hpp"
 
 namespace rtfuse::drivers {
 
@@ -21,6 +24,17 @@ void fourcc_chars(std::uint32_t f, char out[5]) {
 }
 
 }  // namespace
+
+std::uint64_t chain_pair_digest(std::uint64_t previous, const std::uint8_t* left, const std::uint8_t* right,
+                                int width, int height, int stride) noexcept {
+  Xxh64 h(previous);
+  const auto row_bytes = static_cast<std::size_t>(width > 0 ? width : 0);
+  const std::uint8_t* const eyes[2] = {left, right};
+  for (const std::uint8_t* eye : eyes) {
+    for (int y = 0; y < height; ++y) h.update(eye + static_cast<std::ptrdiff_t>(y) * stride, row_bytes);
+  }
+  return h.digest();
+}
 
 const char* to_string(StereoStepOutcome outcome) noexcept {
   switch (outcome) {
@@ -213,6 +227,9 @@ StereoStepOutcome StereoCamera::handle_frame(const hal::VideoFrame& frame, Stere
       const YuyvFrameView view{frame.data, frame.bytes_used, side_by_side_width(mode_), side_by_side_height(mode_),
                                rectifier_.bytes_per_line()};
       if (rectifier_.rectify(view, GreyImageView{w.left, w.stride}, GreyImageView{w.right, w.stride})) {
+        // Before publish(), which takes the slot from this thread: every
+        // published pair is in the digest, in publish order.
+        stats_.pairs_digest = chain_pair_digest(stats_.pairs_digest, w.left, w.right, w.width, w.height, w.stride);
         r->frame_id = pool_.publish(w, frame.stamp, frame.sequence);
         r->stamp = frame.stamp;
         r->sequence = frame.sequence;

@@ -91,8 +91,19 @@ struct StereoCameraStats {
     if (rate_frames < 2 || rate_last_stamp <= rate_first_stamp) return 0.0;
     return static_cast<double>(rate_frames - 1) * 1e9 / static_cast<double>(rate_last_stamp - rate_first_stamp);
   }
+  // XXH64 chained over every published pair in publish order (see
+  // chain_pair_digest): equal after two runs exactly when every pair they
+  // published was the same, byte for byte. 0 before the first pair.
+  std::uint64_t pairs_digest = 0;
   char last_error[256] = {};
 };
+
+// The running digest after one more rectified pair: XXH64 (core/xxh64.hpp)
+// of the left eye's rows then the right eye's, width bytes of each row (the
+// padding up to stride is not part of the image), seeded with the digest of
+// the pairs before it. Integer-only: the same value on every architecture.
+std::uint64_t chain_pair_digest(std::uint64_t previous, const std::uint8_t* left, const std::uint8_t* right,
+                                int width, int height, int stride) noexcept;
 
 class StereoCamera {
  public:

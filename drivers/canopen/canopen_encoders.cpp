@@ -1,6 +1,7 @@
 #include "drivers/canopen/canopen_encoders.hpp"
 
 #include <algorithm>
+#include <cstdarg>
 #include <cstdio>
 
 #include "drivers/canopen/position_unwrap.hpp"
@@ -51,6 +52,7 @@ struct CanopenEncoders::Node {
 
   EncoderReading reading;
   EncoderNodeStats stats;
+  char error[96] = {};  // the last fault in words (node_error())
 };
 
 namespace {
@@ -100,6 +102,23 @@ const EncoderReading& CanopenEncoders::reading(int node) const noexcept {
 const EncoderNodeStats& CanopenEncoders::node_stats(int node) const noexcept {
   static const EncoderNodeStats kNone{};
   return node >= 0 && node < config_.node_count ? nodes_[node].stats : kNone;
+}
+
+const char* CanopenEncoders::node_error(int node) const noexcept {
+  return node >= 0 && node < config_.node_count ? nodes_[node].error : "";
+}
+
+void CanopenEncoders::set_node_error(Node& node, const char* fmt, ...) noexcept {
+  va_list ap;
+  va_start(ap, fmt);
+  std::vsnprintf(node.error, sizeof node.error, fmt, ap);
+  va_end(ap);
+}
+
+void CanopenEncoders::malformed(const hal::CanFrame& frame) noexcept {
+  ++bus_stats_.malformed_frames;
+  std::snprintf(last_error_, sizeof last_error_, "malformed frame COB-ID 0x%03X with %d data bytes; dropped",
+                static_cast<unsigned>(frame.id), static_cast<int>(frame.dlc));
 }
 
 void CanopenEncoders::set_error(const char* what, std::uint32_t cob_id) noexcept {
@@ -199,7 +218,7 @@ void CanopenEncoders::process(const hal::CanFrame& frame) noexcept {
     return;
   }
   if (frame.dlc > 8) {
-    ++bus_stats_.malformed_frames;
+    malformed(frame);
     return;
   }
   if (frame.rtr) {
@@ -234,7 +253,7 @@ void CanopenEncoders::on_error_frame(const hal::CanFrame& frame) noexcept {
 
 void CanopenEncoders::on_tpdo(Node& node, const hal::CanFrame& frame) noexcept {
   if (frame.dlc < node.cfg.tpdo.byte_offset + node.bytes) {
-    ++bus_stats_.malformed_frames;
+    malformed(frame);
     return;
   }
   SyncRecord sync;
@@ -269,6 +288,8 @@ void CanopenEncoders::on_tpdo(Node& node, const hal::CanFrame& frame) noexcept {
     if (node.max_counts_per_s > 0.0 &&
         static_cast<double>(abs64(step)) > node.max_counts_per_s * dt_s + 1.0) {
       // Re-base on the new value so a permanent offset costs one sample.
+      set_node_error(node, "node %d: position jumped %lld counts in one SYNC, faster than %.0f counts/s; rejected",
+                     node.cfg.node_id, static_cast<long long>(step), node.max_counts_per_s);
       jumped = true;
       step = 0;
       ++node.segment;
@@ -291,7 +312,7 @@ void CanopenEncoders::on_tpdo(Node& node, const hal::CanFrame& frame) noexcept {
 
 void CanopenEncoders::on_heartbeat(Node& node, const hal::CanFrame& frame) noexcept {
   if (frame.dlc != cia301::kHeartbeatDlc) {
-    ++bus_stats_.malformed_frames;
+    malformed(frame);
     return;
   }
   const std::uint8_t state = frame.data[0] & cia301::kStateMask;
@@ -317,7 +338,7 @@ void CanopenEncoders::on_heartbeat(Node& node, const hal::CanFrame& frame) noexc
 
 void CanopenEncoders::on_emcy(Node& node, const hal::CanFrame& frame) noexcept {
   if (frame.dlc != cia301::kEmcyDlc) {
-    ++bus_stats_.malformed_frames;
+    malformed(frame);
     return;
   }
   const auto code = static_cast<std::uint16_t>(frame.data[0] | (frame.data[1] << 8));
@@ -329,6 +350,8 @@ void CanopenEncoders::on_emcy(Node& node, const hal::CanFrame& frame) noexcept {
     node.emcy_active = false;
   } else {
     node.emcy_active = true;
+    set_node_error(node, "node %d: EMCY error code 0x%04X, error register 0x%02X", node.cfg.node_id,
+                   static_cast<unsigned>(code), static_cast<unsigned>(frame.data[2]));
   }
 }
 
@@ -339,6 +362,8 @@ void CanopenEncoders::supervise_bus(TimeNs now) noexcept {
   if (off && !bus_off_) {
     bus_off_ = true;
     ++bus_stats_.bus_off_events;
+    std::snprintf(last_error_, sizeof last_error_, "bus-off (%s): every node is invalid until the bus is back",
+                  state == hal::CanBusState::kBusOff ? "the controller's state" : "an error frame");
     for (int i = 0; i < config_.node_count; ++i) {
       Node& node = nodes_[i];
       node.bus_off = true;
@@ -361,6 +386,8 @@ void CanopenEncoders::supervise_heartbeats(TimeNs now) noexcept {
     node.hb_timed_out = !bus_off_ && config_.heartbeat_timeout_ns > 0 && node.hb_seen &&
                         now - node.last_hb > config_.heartbeat_timeout_ns;
     if (node.hb_timed_out && !node.silent) {
+      set_node_error(node, "node %d: no heartbeat for more than %lld ms", node.cfg.node_id,
+                     static_cast<long long>(config_.heartbeat_timeout_ns / 1'000'000));
       node.silent = true;
       node.resync = node.has_raw;
       ++node.stats.silent_events;
@@ -396,6 +423,9 @@ void CanopenEncoders::detect_stuck(const SyncRecord& sync) noexcept {
       if (!node.stuck && node.still_ns >= config_.stuck_time_ns && most > config_.stuck_min_counts) {
         node.stuck = true;
         ++node.stats.stuck_events;
+        set_node_error(node, "node %d: counter unchanged for %lld ms or more while another wheel moved %lld counts",
+                       node.cfg.node_id, static_cast<long long>(config_.stuck_time_ns / 1'000'000),
+                       static_cast<long long>(most));
       }
     }
     node.prev_info_time = sync.time;
@@ -426,6 +456,7 @@ void CanopenEncoders::close_set(const SyncRecord& sync) noexcept {
       ++node.stats.missed_syncs;
     }
     if (!node.silent && node.missed >= config_.tpdo_timeout_syncs) {
+      set_node_error(node, "node %d: no TPDO for %d SYNCs in a row", node.cfg.node_id, node.missed);
       node.silent = true;
       node.resync = node.has_raw;
       ++node.stats.silent_events;

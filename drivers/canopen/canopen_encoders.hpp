@@ -80,8 +80,12 @@ class CanopenEncoders {
   const EncoderNodeStats& node_stats(int node) const noexcept;
   const CanopenBusStats& bus_stats() const noexcept { return bus_stats_; }
   const CanopenEncodersConfig& config() const noexcept { return config_; }
-  // Text of the last send or receive failure ("" if none).
+  // Text of the bus's last failure: a refused send, a failed receive, a
+  // malformed frame, bus-off ("" if none). Kept after the bus recovers.
   const char* last_error() const noexcept { return last_error_; }
+  // Text of the node's last fault: silent, EMCY, stuck, jump ("" if none).
+  // Kept after the node recovers. Bus-off is the bus's, in last_error().
+  const char* node_error(int node) const noexcept;
 
  private:
   struct Node;
@@ -108,6 +112,8 @@ class CanopenEncoders {
   bool send_nmt_start(Node& node, TimeNs now) noexcept;
   void send_sync(TimeNs now) noexcept;
   void set_error(const char* what, std::uint32_t cob_id) noexcept;
+  void malformed(const hal::CanFrame& frame) noexcept;
+  static void set_node_error(Node& node, const char* fmt, ...) noexcept __attribute__((format(printf, 2, 3)));
 
   hal::CanBus& bus_;
   CanopenEncodersConfig config_;

@@ -2,18 +2,13 @@
 
 #include <cmath>
 
-#include "drivers/camera/zed_calibration.hpp"
+#include "runtime/camera_calibration.hpp"
 
 namespace rtfuse {
 
 bool camera_driver_config(const CameraSection& c, drivers::StereoCameraConfig* out, std::string* error) {
-  drivers::ZedResolution resolution;
-  if (!drivers::parse_resolution(c.resolution.view(), &resolution)) {
-    *error = "camera.resolution '" + std::string(c.resolution.view()) + "' is not one of 2K, FHD, HD, VGA";
-    return false;
-  }
   drivers::ZedCalibration calibration;
-  if (!drivers::load_zed_calibration(c.calibration_file, resolution, c.serial, &calibration, error)) return false;
+  if (!load_camera_calibration(c, c.serial, &calibration, error)) return false;
   drivers::StereoCameraConfig d;
   d.resolution = std::string(c.resolution.view());
   d.fps = c.fps;
@@ -63,8 +58,11 @@ void CameraDevice::fill_snapshot(Snapshot& s) noexcept {
   set_device_values(d, kCameraKeys, kCameraKeyCount,
                     {st.rectified, static_cast<std::int64_t>(std::lround(st.measured_fps() * 1000.0)),
                      st.stream.dropped, st.stream.sequence_gaps, st.rejected_size, st.rejected_corrupted,
-                     st.pool_full, st.stream.timeouts, st.lost, st.reopen_attempts, st.stream.reopens, st.errors});
+                     st.pool_full, st.stream.timeouts, st.lost, st.reopen_attempts, st.stream.reopens, st.errors,
+                     // The digest's 64 bits as they are (two's complement).
+                     static_cast<std::int64_t>(st.pairs_digest)});
   d.state = drivers::to_string(h.last);
+  set_device_message(d.message, st.last_error);
   switch (h.last) {
     case drivers::StereoStepOutcome::kFrame: d.level = DeviceLevel::kOk; break;
     case drivers::StereoStepOutcome::kLost:

@@ -22,10 +22,17 @@ const char* const kImuKeys[] = {"samples",   "reads",     "nacks",         "bus_
 const int kImuKeyCount = sizeof(kImuKeys) / sizeof(kImuKeys[0]);
 
 // fps_milli: the rate measured from the capture stamps, in 1/1000 fps.
+// pairs_digest: StereoCameraStats::pairs_digest's bits as an int64.
 const char* const kCameraKeys[] = {"frames",    "fps_milli",       "dropped", "sequence_gaps",
                                    "rejected_size", "rejected_corrupted", "pool_full", "timeouts",
-                                   "lost",      "reopen_attempts", "reopens", "errors"};
+                                   "lost",      "reopen_attempts", "reopens", "errors",
+                                   "pairs_digest"};
 const int kCameraKeyCount = sizeof(kCameraKeys) / sizeof(kCameraKeys[0]);
+static_assert(sizeof(kCameraKeys) / sizeof(kCameraKeys[0]) <= kMaxDeviceValues, "more camera keys than a device holds");
+static_assert(sizeof(kImuKeys) / sizeof(kImuKeys[0]) <= kMaxDeviceValues, "more IMU keys than a device holds");
+static_assert(sizeof(kEncoderNodeKeys) / sizeof(kEncoderNodeKeys[0]) <= kMaxDeviceValues,
+              "more encoder node keys than a device holds");
+static_assert(sizeof(kCanBusKeys) / sizeof(kCanBusKeys[0]) <= kMaxDeviceValues, "more CAN bus keys than a device holds");
 
 DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
   DeviceSlots s;

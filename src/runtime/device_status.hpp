@@ -1,8 +1,10 @@
 #pragma once
 // Health of the devices the process drives itself (encoder nodes, the CAN
 // bus, the IMU), in the snapshot the loop publishes. Trivially copyable: the
-// counter names are pointers to string literals, fixed per configuration.
+// counter names are pointers to string literals, fixed per configuration,
+// and the last error's text is stored inline.
 #include <cstdint>
+#include <cstring>
 
 #include "core/fixed_string.hpp"
 
@@ -13,10 +15,29 @@ constexpr int kMaxDeviceValues = 20;
 
 enum class DeviceLevel : std::int8_t { kOk = 0, kWarn = 1, kError = 2, kStale = 3 };
 
+// The device's last error in words, as diagnostic_msgs/DiagnosticStatus's
+// message: "" while there has been none.
+using DeviceMessage = FixedString<127>;
+
+// Stores text (null: ""), cut to fit with "..." at the end when longer.
+inline void set_device_message(DeviceMessage& m, const char* text) noexcept {
+  constexpr std::size_t kMax = DeviceMessage::max_size();
+  const std::size_t n = text == nullptr ? 0 : std::strlen(text);
+  if (n <= kMax) {
+    m.assign(std::string_view(text == nullptr ? "" : text, n));
+    return;
+  }
+  char cut[kMax + 1];
+  std::memcpy(cut, text, kMax - 3);
+  std::memcpy(cut + kMax - 3, "...", 3);
+  m.assign(std::string_view(cut, kMax));
+}
+
 struct DeviceStatus {
   FixedString<47> name;
   FixedString<47> hardware_id;
   FixedString<23> state;
+  DeviceMessage message;
   DeviceLevel level = DeviceLevel::kStale;
   int num_values = 0;
   const char* keys[kMaxDeviceValues] = {};

@@ -95,6 +95,8 @@ drivers::StepResult ImuDevice::step_imu(TimeNs timeout_ns) noexcept {
   }
   h.last = r;
   h.stats = imu_->stats();
+  const char* error = imu_->error();
+  if (error[0] != '\0') set_device_message(h.error, error);
   health_.store(h);
   return r;
 }
@@ -110,6 +112,7 @@ void ImuDevice::fill_snapshot(Snapshot& s) noexcept {
                      st.saturated, st.impossible, st.missing_edges, st.out_of_order_edges, st.reinits,
                      st.filter_rejects, static_cast<std::int64_t>(std::lround(h.temperature_c * 1000.0))});
   d.state = drivers::to_string(h.last);
+  d.message = h.error;
   switch (h.last) {
     case drivers::StepResult::kSample: d.level = DeviceLevel::kOk; break;
     case drivers::StepResult::kDown: d.level = st.samples == 0 ? DeviceLevel::kStale : DeviceLevel::kError; break;

@@ -46,6 +46,9 @@ class ImuDevice final : public ThreadDevice {
     drivers::StepResult last = drivers::StepResult::kDown;
     double temperature_c = 0.0;
     std::int64_t last_sample_ns = 0;
+    // The driver's last error, kept after a successful re-initialisation
+    // (which clears the driver's own text).
+    DeviceMessage error;
   };
 
   FusionCore& core_;

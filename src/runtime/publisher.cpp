@@ -190,12 +190,16 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
     d.keys.resize(static_cast<std::size_t>(layout[i].num_values));
     d.values.assign(static_cast<std::size_t>(layout[i].num_values), 0);
     for (int k = 0; k < layout[i].num_values; ++k) d.keys[static_cast<std::size_t>(k)] = layout[i].keys[k];
-    // Sized for the longest state word so the buffer and the string's
-    // capacity never have to grow in poll().
+    // Sized for the longest state word and message so the buffer and the
+    // strings' capacities never have to grow in poll().
     d.state.assign(decltype(layout[i].state)::max_size(), ' ');
+    d.message.assign(DeviceMessage::max_size(), ' ');
   }
   m.diagnostics.finalize();
-  for (auto& d : m.diagnostics.msg.devices) d.state = "starting";
+  for (auto& d : m.diagnostics.msg.devices) {
+    d.state = "starting";
+    d.message.clear();  // keeps the capacity
+  }
 
   const WheelOdometrySection& w = c.hardware.wheel_odometry;
   m.wheel_channel = w.raw_channel;
@@ -350,6 +354,7 @@ int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, Message
       auto& out = d.devices[static_cast<std::size_t>(i)];
       out.level = static_cast<std::int8_t>(in.level);
       out.state.assign(in.state.c_str());
+      out.message.assign(in.message.c_str(), in.message.size());
       const int n = in.num_values < out.num_values ? in.num_values : out.num_values;
       for (int k = 0; k < n; ++k) out.values[static_cast<std::size_t>(k)] = in.values[k];
     }

@@ -128,6 +128,7 @@ void WheelEncoderDevice::fill_snapshot(Snapshot& s) noexcept {
   set_device_values(bus, kCanBusKeys, kCanBusKeyCount,
              {b.frames_received, b.syncs_sent, b.send_failures, b.malformed_frames, b.unexpected_cob_ids,
               b.error_frames, b.bus_off_events});
+  set_device_message(bus.message, encoders_->last_error());
   if (b.bus_off) {
     bus.level = DeviceLevel::kError;
     bus.state = "bus-off";
@@ -150,6 +151,7 @@ void WheelEncoderDevice::fill_snapshot(Snapshot& s) noexcept {
                 n.jump_events, n.recoveries, n.nmt_starts});
     d.level = encoder_level(r.health);
     d.state = drivers::to_string(r.health);
+    set_device_message(d.message, encoders_->node_error(i));
   }
   if (wheels_ && slots_.wheel_odometry >= 0) {
     const drivers::WheelOdometryStats& w = wheels_->stats();
@@ -157,6 +159,8 @@ void WheelEncoderDevice::fill_snapshot(Snapshot& s) noexcept {
     set_device_values(d, kWheelOdometryKeys, kWheelOdometryKeyCount, {w.outputs, w.no_side, w.reseeds});
     d.level = w.outputs == 0 ? DeviceLevel::kStale : DeviceLevel::kOk;
     d.state = w.outputs == 0 ? "waiting" : "running";
+    // Its failures are its inputs': the nodes say what they were.
+    d.message = DeviceMessage();
     if (have_twist_) {
       WheelOdometrySnapshot& o = s.wheel_odometry;
       o.valid = true;

@@ -4,6 +4,8 @@
 //
 //   BM_RectifyVgaPair     672 x 376 per eye (1344 x 376 YUYV frame)
 //   BM_RectifyHd720Pair   1280 x 720 per eye (2560 x 720 YUYV frame)
+//   BM_PairDigestVga      the driver's digest of one rectified VGA pair
+//                         (chain_pair_digest: XXH64 over both eyes' rows)
 //
 // Targets on the reference x86-64 (-O2, no -march=native): <= 1.0 ms and
 // <= 3 ms median. Every iteration must allocate nothing (allocs_per_iter = 0;
@@ -14,6 +16,8 @@
 #include <string>
 #include <vector>
 
+#include "core/frame_pool.hpp"
+#include "drivers/camera/stereo_camera.hpp"
 #include "drivers/camera/stereo_rectification.hpp"
 #include "drivers/camera/stereo_rectifier.hpp"
 #include "support/alloc_counter.hpp"
@@ -83,5 +87,43 @@ BENCHMARK(BM_RectifyVgaPair)->Unit(benchmark::kMicrosecond);
 
 void BM_RectifyHd720Pair(benchmark::State& state) { rectify_pair(state, rtfuse::test::zed_like_hd()); }
 BENCHMARK(BM_RectifyHd720Pair)->Unit(benchmark::kMicrosecond);
+
+// What the camera thread adds per published pair: both eyes of a VGA pair
+// in a frame pool slot (rows padded to the pool's stride), digested and
+// chained as StereoCamera does after rectifying.
+void BM_PairDigestVga(benchmark::State& state) {
+  constexpr int kW = 672;
+  constexpr int kH = 376;
+  rtfuse::FramePool pool(2, kW, kH);
+  rtfuse::FramePool::WriteSlot slot = pool.acquire();
+  if (!slot.valid()) {
+    state.SkipWithError("no pool slot");
+    return;
+  }
+  std::uint32_t noise = 12345u;
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      noise = noise * 1664525u + 1013904223u;
+      slot.left[y * slot.stride + x] = static_cast<std::uint8_t>(noise >> 24);
+      slot.right[y * slot.stride + x] = static_cast<std::uint8_t>(noise >> 16);
+    }
+  }
+  std::uint64_t digest = 0;
+  std::size_t allocations = 0;
+  {
+    AllocScope allocs;
+    for (auto _ : state) {
+      digest = rtfuse::drivers::chain_pair_digest(digest, slot.left, slot.right, slot.width, slot.height,
+                                                  slot.stride);
+      benchmark::DoNotOptimize(digest);
+    }
+    allocations = allocs.count();
+  }
+  pool.abandon(slot);
+  state.counters["allocs_per_iter"] =
+      benchmark::Counter(static_cast<double>(allocations), benchmark::Counter::kAvgIterations);
+  state.SetBytesProcessed(static_cast<std::int64_t>(state.iterations()) * 2 * kW * kH);
+}
+BENCHMARK(BM_PairDigestVga)->Unit(benchmark::kMicrosecond);
 
 }  // namespace

@@ -84,9 +84,13 @@ TEST(CanopenFaults, NodeSilentForTwoSecondsIsExcludedThenRecovers) {
     EXPECT_FALSE(rig.r(0).valid);
     EXPECT_FALSE(rig.enc->take_sample_set(&set)) << "node 1 has not answered: set incomplete";
   }
+  EXPECT_STREQ(rig.enc->node_error(0), "");
   rig.tick();  // the fifth SYNC without a TPDO
   EXPECT_EQ(rig.r(0).health, EncoderHealth::kSilent);
   EXPECT_EQ(rig.st(0).silent_events, 1);
+  EXPECT_STREQ(rig.enc->node_error(0), "node 1: no TPDO for 5 SYNCs in a row");
+  EXPECT_STREQ(rig.enc->node_error(1), "");
+  EXPECT_STREQ(rig.enc->node_error(2), "") << "no such node";
   ASSERT_TRUE(rig.enc->take_sample_set(&set)) << "a silent node no longer holds the others back";
   EXPECT_EQ(set.valid_count, 1);
   EXPECT_FALSE(set.readings[0].valid);
@@ -102,6 +106,7 @@ TEST(CanopenFaults, NodeSilentForTwoSecondsIsExcludedThenRecovers) {
   ASSERT_TRUE(rig.r(0).valid);
   EXPECT_EQ(rig.r(0).health, EncoderHealth::kOk);
   EXPECT_EQ(rig.st(0).recoveries, 1);
+  EXPECT_STREQ(rig.enc->node_error(0), "node 1: no TPDO for 5 SYNCs in a row") << "kept after the recovery";
   EXPECT_EQ(rig.r(0).segment, segment0 + 1) << "continuity across the silence is not vouched for";
   // A 32-bit counter moved far less than half its range: the guess is right.
   EXPECT_EQ(rig.r(0).counts - counts0, rig.node(0).counts_at(rig.r(0).stamp) - truth0);
@@ -120,6 +125,7 @@ TEST(CanopenFaults, HeartbeatTimeoutAloneMakesANodeSilent) {
   rig.run_for(20 * kMs);  // 810 ms: 510 ms
   EXPECT_EQ(rig.r(0).health, EncoderHealth::kSilent);
   EXPECT_EQ(rig.st(0).silent_events, 1);
+  EXPECT_STREQ(rig.enc->node_error(0), "node 1: no heartbeat for more than 500 ms");
 }
 
 TEST(CanopenFaults, RebootedNodeIsStartedAgainRateLimited) {
@@ -188,6 +194,8 @@ TEST(CanopenFaults, StuckCounterWhileTheOtherWheelMovesIsExcludedThenRecovers) {
   EXPECT_FALSE(rig.r(0).valid);
   EXPECT_EQ(rig.r(0).health, EncoderHealth::kStuck);
   EXPECT_EQ(rig.st(0).stuck_events, 1);
+  const std::string stuck = rig.enc->node_error(0);
+  EXPECT_EQ(stuck.rfind("node 1: counter unchanged for 1000 ms or more while another wheel moved ", 0), 0u) << stuck;
   EXPECT_TRUE(rig.r(1).valid);
   EXPECT_EQ(rig.st(1).stuck_events, 0);
   rig.run_for(500 * kMs);
@@ -231,6 +239,8 @@ TEST(CanopenFaults, JumpIsRejectedAndTheUnwrapRebased) {
   EXPECT_FALSE(rig.r(0).valid);
   EXPECT_EQ(rig.r(0).health, EncoderHealth::kJump);
   EXPECT_EQ(rig.st(0).jump_events, 1);
+  EXPECT_STREQ(rig.enc->node_error(0),
+               "node 1: position jumped 100005 counts in one SYNC, faster than 5000 counts/s; rejected");
   EXPECT_EQ(rig.r(0).segment, seg0 + 1);
   EXPECT_TRUE(rig.r(1).valid) << "only the glitching node is excluded";
   rig.tick();
@@ -315,10 +325,13 @@ TEST(CanopenFaults, BusOffErrorFrameUntilRestarted) {
   err.id = 0x40;  // CAN_ERR_BUSOFF
   err.dlc = 8;
   rig.bus.inject(err);
+  EXPECT_STREQ(rig.enc->last_error(), "");
   rig.tick();
   EXPECT_EQ(rig.r(0).health, EncoderHealth::kBusOff);
   EXPECT_EQ(rig.enc->bus_stats().bus_off_events, 1);
   EXPECT_EQ(rig.enc->bus_stats().error_frames, 1);
+  EXPECT_STREQ(rig.enc->last_error(), "bus-off (an error frame): every node is invalid until the bus is back");
+  EXPECT_STREQ(rig.enc->node_error(0), "") << "the bus's error, not the node's";
   // A second bus-off report while still off is the same event.
   err.stamp = 0;
   rig.bus.inject(err);
@@ -346,6 +359,7 @@ TEST(CanopenFaults, EmcyExcludesTheNodeUntilErrorReset) {
   EXPECT_EQ(rig.st(0).emcys, 1);
   EXPECT_EQ(rig.st(0).last_emcy_code, 0x7305);
   EXPECT_EQ(rig.st(0).last_emcy_register, 0x81);
+  EXPECT_STREQ(rig.enc->node_error(0), "node 1: EMCY error code 0x7305, error register 0x81");
   EXPECT_TRUE(rig.r(1).valid);
   EncoderSampleSet set;
   ASSERT_TRUE(rig.enc->take_sample_set(&set)) << "an excluded node does not make the set incomplete";
@@ -360,6 +374,8 @@ TEST(CanopenFaults, EmcyExcludesTheNodeUntilErrorReset) {
   EXPECT_EQ(rig.st(0).emcy_resets, 1);
   EXPECT_EQ(rig.st(0).last_emcy_code, 0x0000);
   EXPECT_EQ(rig.st(0).recoveries, 1);
+  EXPECT_STREQ(rig.enc->node_error(0), "node 1: EMCY error code 0x7305, error register 0x81")
+      << "an error reset is no error; the last one is kept";
 }
 
 TEST(CanopenFaults, MalformedAndUnexpectedFramesAreCountedAndHarmless) {
@@ -396,6 +412,7 @@ TEST(CanopenFaults, MalformedAndUnexpectedFramesAreCountedAndHarmless) {
   rig.tick();
   const auto& after = rig.enc->bus_stats();
   EXPECT_EQ(after.malformed_frames - before.malformed_frames, 5);
+  EXPECT_STREQ(rig.enc->last_error(), "malformed frame COB-ID 0x181 with 200 data bytes; dropped");
   EXPECT_EQ(after.rtr_frames - before.rtr_frames, 1);
   EXPECT_EQ(after.unexpected_cob_ids - before.unexpected_cob_ids, 4);
   EXPECT_EQ(after.error_frames - before.error_frames, 1);

@@ -242,6 +242,7 @@ TEST(Hardware, DeviceStatusNamesLevelsAndCounters) {
   EXPECT_STREQ(s.devices[1].state.c_str(), "ok");
   EXPECT_STREQ(s.devices[2].state.c_str(), "ok");
   EXPECT_STREQ(s.devices[3].state.c_str(), "running");
+  for (int i = 0; i < 4; ++i) EXPECT_STREQ(s.devices[i].message.c_str(), "") << "no error yet";
 
   const DeviceStatus& bus = s.devices[0];
   // One SYNC per tick; besides them only the two NMT starts went out.
@@ -288,8 +289,10 @@ TEST(Hardware, SilentNodeIsReportedAndRecovers) {
     const DeviceStatus& right = s.devices[2];
     EXPECT_EQ(right.level, DeviceLevel::kError);
     EXPECT_STREQ(right.state.c_str(), "silent");
+    EXPECT_STREQ(right.message.c_str(), "node 2: no TPDO for 5 SYNCs in a row");
     EXPECT_EQ(value(right, "silent_events"), 1);
     EXPECT_EQ(s.devices[1].level, DeviceLevel::kOk) << "the left node kept answering";
+    EXPECT_STREQ(s.devices[1].message.c_str(), "");
     // Without its right side the wheels give no twist: nothing fused, the
     // sensor timed out, the estimate coasts but stays finite.
     EXPECT_EQ(s.sensors[0].accepted, accepted_silent);
@@ -304,6 +307,7 @@ TEST(Hardware, SilentNodeIsReportedAndRecovers) {
   const DeviceStatus& right = s.devices[2];
   EXPECT_EQ(right.level, DeviceLevel::kOk);
   EXPECT_STREQ(right.state.c_str(), "ok");
+  EXPECT_STREQ(right.message.c_str(), "node 2: no TPDO for 5 SYNCs in a row") << "the last error is kept";
   EXPECT_EQ(value(right, "recoveries"), 1);
   EXPECT_EQ(value(right, "silent_events"), 1);
   EXPECT_GT(s.sensors[0].accepted, accepted_silent + 150);
@@ -327,9 +331,12 @@ TEST(Hardware, BusOffIsAnErrorOfTheBusAndRecovers) {
     // Every SYNC of the 100 ticks was refused.
     EXPECT_EQ(value(bus, "send_failures"), 100);
     EXPECT_EQ(value(bus, "syncs_sent"), 200);
+    // The refused SYNCs came after the bus-off itself.
+    EXPECT_STREQ(bus.message.c_str(), "SYNC (COB-ID 0x080) refused by the bus: mock: bus-off");
     for (int n = 1; n <= 2; ++n) {
       EXPECT_EQ(s.devices[n].level, DeviceLevel::kError);
       EXPECT_STREQ(s.devices[n].state.c_str(), "bus-off");
+      EXPECT_STREQ(s.devices[n].message.c_str(), "") << "bus-off is the bus's error";
     }
     EXPECT_TRUE(all_finite(s));
   }
@@ -465,6 +472,28 @@ TEST(Hardware, ImuYawRateReachesTheEstimate) {
   EXPECT_EQ(value(imu, "missing_edges"), 0);
   EXPECT_EQ(value(imu, "reinits"), 0);
   EXPECT_NEAR(static_cast<double>(value(imu, "temperature_mdegc")), 25'000.0, 5.0);
+  EXPECT_STREQ(imu.message.c_str(), "");
+}
+
+// Reads that time out until the driver initialises the chip again: the
+// message says what failed and keeps saying it once samples flow again (the
+// successful re-initialisation clears the driver's own text).
+TEST(Hardware, ImuMessageKeepsTheLastErrorAfterRecovery) {
+  ImuRig rig(std::string(kFilter) + kMpu + kImuMount);
+  ASSERT_TRUE(rig.core);
+  ASSERT_TRUE(rig.start()) << rig.error;
+  for (int i = 0; i < 20; ++i) rig.step(0.3);
+  EXPECT_STREQ(rig.snap().devices[0].message.c_str(), "");
+  rig.i2c.fail_next(hal::HalStatus::kTimeout, 5);
+  int samples = 0;
+  for (int i = 0; i < 40; ++i) samples += rig.step(0.3) == drivers::StepResult::kSample;
+  EXPECT_GT(samples, 30);
+  const Snapshot& s = rig.snap();
+  const DeviceStatus& imu = s.devices[0];
+  EXPECT_EQ(value(imu, "reinits"), 1);
+  EXPECT_STREQ(imu.state.c_str(), "sample");
+  EXPECT_EQ(std::string(imu.message.c_str()).rfind("mpu at 0x68: data read failed (timeout", 0), 0u)
+      << imu.message.c_str();
 }
 
 TEST(Hardware, ImuStepAllocatesNothingInSteadyState) {

@@ -324,8 +324,8 @@ TEST(Publisher, SteadyStatePollNeverAllocates) {
 }
 
 // A robot with two encoder nodes and an IMU: the diagnostics carry one
-// device_status_t per device with fixed keys, and only values, level and
-// state change from message to message, without allocating.
+// device_status_t per device with fixed keys, and only values, level, state
+// and message change from message to message, without allocating.
 TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   RuntimeConfig cfg = two_sensor_config();
   cfg.publish.diagnostics_rate_hz = 100.0;
@@ -350,6 +350,7 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   right.state = "silent";
   right.values[0] = 123456;  // counts
   right.values[5] = 2;       // silent_events
+  set_device_message(right.message, "node 2: no heartbeat for more than 350 ms");
   s.devices[slots.imu].level = DeviceLevel::kOk;
   s.devices[slots.imu].state = "sampling";
 
@@ -368,15 +369,21 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   EXPECT_EQ(d.devices[2].values[0], 123456);
   EXPECT_EQ(d.devices[2].keys[5], "silent_events");
   EXPECT_EQ(d.devices[2].values[5], 2);
+  EXPECT_EQ(d.devices[2].message, "node 2: no heartbeat for more than 350 ms");
+  EXPECT_EQ(d.devices[1].message, "") << "no error yet";
   EXPECT_EQ(d.devices[4].name, "imu");
   EXPECT_EQ(d.devices[4].hardware_id, "/dev/i2c-1 0x68");
   EXPECT_EQ(d.devices[4].state, "sampling");
   EXPECT_EQ(d.devices[4].level, kOk);
 
-  // The node recovers: a longer state word, new values, no allocation.
+  // The node recovers: a longer state word, new values, a message as long
+  // as a message gets (a longer text is cut, "..." at its end), no allocation.
   right.level = DeviceLevel::kOk;
   right.state = "operational-recovered";
   right.values[8] = 1;  // recoveries
+  const std::string long_text = "node 2: " + std::string(300, 'x');
+  set_device_message(right.message, long_text.c_str());
+  ASSERT_EQ(right.message.size(), DeviceMessage::max_size());
   CountingSink counting;
   std::size_t allocations = 0;
   {
@@ -390,6 +397,12 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   d = sink.last<rtfuse::diagnostics_t>("rtfuse/diagnostics");
   EXPECT_EQ(d.devices[2].state, "operational-recovered");
   EXPECT_EQ(d.devices[2].values[8], 1);
+  EXPECT_EQ(d.devices[2].message, long_text.substr(0, DeviceMessage::max_size() - 3) + "...");
+  // And back to a short one.
+  set_device_message(right.message, "node 2: EMCY error code 0x8130, error register 0x11");
+  pub.poll(s, 3000 * kMs, sink);
+  d = sink.last<rtfuse::diagnostics_t>("rtfuse/diagnostics");
+  EXPECT_EQ(d.devices[2].message, "node 2: EMCY error code 0x8130, error register 0x11");
   EXPECT_EQ(pub.encode_failures(), 0);
 }
 
