@@ -10,7 +10,7 @@
 # the packed programs (packaging/deb-depends.cmake), so a static libstdc++
 # (the cross toolchain's default) drops libstdc++6 and a native build keeps it.
 
-set(RTFUSE_PACKAGE_PROGRAMS rtfused rtfuse-replay rtfuse-sim)
+set(RTFUSE_PACKAGE_PROGRAMS rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot)
 foreach(prog IN LISTS RTFUSE_PACKAGE_PROGRAMS)
   if(NOT TARGET ${prog})
     message(FATAL_ERROR "Packaging: program target '${prog}' does not exist (src/apps)")
@@ -55,6 +55,9 @@ file(GLOB RTFUSE_PACKAGE_CONFIGS CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/config/*.
 install(FILES ${RTFUSE_PACKAGE_CONFIGS} DESTINATION etc/rtfuse)
 file(GLOB RTFUSE_PACKAGE_SCENARIOS CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/config/scenarios/*.toml)
 install(FILES ${RTFUSE_PACKAGE_SCENARIOS} DESTINATION etc/rtfuse/scenarios)
+# Camera factory calibrations the configs name (sim.toml's simulated camera).
+file(GLOB RTFUSE_PACKAGE_CALIBRATIONS CONFIGURE_DEPENDS ${CMAKE_SOURCE_DIR}/config/calibration/*.conf)
+install(FILES ${RTFUSE_PACKAGE_CALIBRATIONS} DESTINATION etc/rtfuse/calibration)
 # The service's config: the real robot's, to be edited on the board.
 install(FILES ${CMAKE_SOURCE_DIR}/config/robot_linux.toml DESTINATION etc/rtfuse RENAME rtfused.toml)
 
@@ -97,8 +100,9 @@ set(CPACK_PACKAGE_DESCRIPTION_SUMMARY "real-time EKF sensor fusion daemon for ro
 string(CONCAT CPACK_PACKAGE_DESCRIPTION
   "rtfused fuses wheel encoders on SocketCAN and an MPU-6050 IMU on i2c-dev\n"
   "in a fixed-rate real-time loop and publishes odometry over LCM. Includes\n"
-  "the rtfused.service systemd unit, rtfuse-replay, rtfuse-sim, example\n"
-  "configs in /etc/rtfuse, the LCM types as a jar and Python modules.")
+  "the rtfused.service systemd unit, rtfuse-replay, rtfuse-sim,\n"
+  "rtfuse-camera-snapshot, example configs in /etc/rtfuse, the LCM types as\n"
+  "a jar and Python modules.")
 set(CPACK_STRIP_FILES ON)
 set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${RTFUSE_DEB_ARCH})
 set(CPACK_DEBIAN_FILE_NAME "rtfuse_${PROJECT_VERSION}_${RTFUSE_DEB_ARCH}.deb")
@@ -122,6 +126,10 @@ string(APPEND _rtfuse_conffiles "/etc/rtfuse/rtfused.toml\n")
 foreach(s IN LISTS RTFUSE_PACKAGE_SCENARIOS)
   get_filename_component(n ${s} NAME)
   string(APPEND _rtfuse_conffiles "/etc/rtfuse/scenarios/${n}\n")
+endforeach()
+foreach(s IN LISTS RTFUSE_PACKAGE_CALIBRATIONS)
+  get_filename_component(n ${s} NAME)
+  string(APPEND _rtfuse_conffiles "/etc/rtfuse/calibration/${n}\n")
 endforeach()
 file(WRITE ${CMAKE_BINARY_DIR}/packaging/conffiles "${_rtfuse_conffiles}")
 set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA

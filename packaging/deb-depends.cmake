@@ -31,6 +31,8 @@ set(_soname_pkg_liblcm.so.1 liblcm1)
 set(_soname_pkg_libgpiod.so.2 "libgpiod2 (>= 1.6.3)")
 set(_soname_pkg_libglib-2.0.so.0 "libglib2.0-0 (>= 2.56)")
 set(_soname_pkg_libtomlplusplus.so.3 "libtomlplusplus3 (>= 3.3.0)")
+set(_soname_pkg_libpng16.so.16 "libpng16-16 (>= 1.6.2-1)")
+set(_soname_pkg_libz.so.1 "zlib1g (>= 1:1.2.0)")
 
 # GLIBCXX_3.4.N -> the first GCC whose libstdc++ has it (Debian's libstdc++6
 # is versioned by GCC release).

@@ -454,8 +454,7 @@ bool parse_zed_calibration(std::string_view text, std::string_view name, ZedReso
   return true;
 }
 
-bool load_zed_calibration(const std::string& path, ZedResolution resolution, std::int64_t expected_serial,
-                          ZedCalibration* calibration, std::string* error) {
+bool read_zed_calibration_file(const std::string& path, std::string* text, std::string* error) {
   Reporter report(path, error);
   std::FILE* file = std::fopen(path.c_str(), "rb");
   if (file == nullptr) {
@@ -463,14 +462,14 @@ bool load_zed_calibration(const std::string& path, ZedResolution resolution, std
     return report.fail(0, "cannot open: %s%s", std::strerror(e),
                        e == ENOENT ? " (download it from https://calib.stereolabs.com/?SN=<serial>)" : "");
   }
-  std::string text;
+  std::string bytes;
   char buf[4096];
   bool too_big = false;
   bool read_error = false;
   for (;;) {
     const std::size_t n = std::fread(buf, 1, sizeof buf, file);
-    text.append(buf, n);
-    if (text.size() > kMaxZedCalibrationBytes) {
+    bytes.append(buf, n);
+    if (bytes.size() > kMaxZedCalibrationBytes) {
       too_big = true;
       break;
     }
@@ -485,7 +484,15 @@ bool load_zed_calibration(const std::string& path, ZedResolution resolution, std
   if (too_big) {
     return report.fail(0, "larger than %zu bytes: this is not a ZED calibration file", kMaxZedCalibrationBytes);
   }
-  return parse_zed_calibration(text, path, resolution, expected_serial, calibration, error);
+  *text = std::move(bytes);
+  return true;
+}
+
+bool load_zed_calibration(const std::string& path, ZedResolution resolution, std::int64_t expected_serial,
+                          ZedCalibration* calibration, std::string* error) {
+  std::string text;
+  return read_zed_calibration_file(path, &text, error) &&
+         parse_zed_calibration(text, path, resolution, expected_serial, calibration, error);
 }
 
 }  // namespace rtfuse::drivers

@@ -68,6 +68,10 @@ struct ZedCalibration {
 bool parse_zed_calibration(std::string_view text, std::string_view name, ZedResolution resolution,
                            std::int64_t expected_serial, ZedCalibration* calibration, std::string* error);
 
+// The bytes of the file at `path` (at most kMaxZedCalibrationBytes); on
+// failure *error names the file and the errno text.
+bool read_zed_calibration_file(const std::string& path, std::string* text, std::string* error);
+
 // Reads the file at `path` and parses it as above.
 bool load_zed_calibration(const std::string& path, ZedResolution resolution, std::int64_t expected_serial,
                           ZedCalibration* calibration, std::string* error);

@@ -16,7 +16,13 @@
 
 #include "apps/stereo_png.hpp"
 #include "hal/mock/sim_clock.hpp"
+#include "hal/replay/replay_video_stream.hpp"
+#include "runtime/camera_calibration.hpp"
+#include "runtime/camera_device.hpp"
 #include "runtime/config_loader.hpp"
+#include "runtime/hal_replay.hpp"
+#include "runtime/recording_tap.hpp"
+#include "transport/hal_record_codec.hpp"
 #include "runtime/linux_hal.hpp"
 #include "runtime/tick_pipeline.hpp"
 #include "sim/simulated_robot.hpp"
@@ -28,6 +34,91 @@ class NullSink final : public rtfuse::MessageSink {
   bool publish(const char*, const std::uint8_t*, int, rtfuse::TimeNs) override { return true; }
 };
 
+int write_pair(rtfuse::FramePool& pool, const rtfuse::drivers::StereoRectification& r,
+               const rtfuse::drivers::StereoCameraStats& st, const std::string& out_path, int guide_px) {
+  rtfuse::FramePool::Handle h = pool.take_latest();
+  if (!h.valid()) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: no frame from the camera (%lld dequeued, %lld timeouts, %lld rejected): %s\n",
+                 static_cast<long long>(st.frames), static_cast<long long>(st.stream.timeouts),
+                 static_cast<long long>(st.rejected_size + st.rejected_corrupted), st.last_error);
+    return 1;
+  }
+  const rtfuse::FramePool::Frame f = pool.frame(h);
+  std::string error;
+  const bool ok = rtfuse::apps::write_stereo_png(out_path, f.left, f.right, f.width, f.height, f.stride, guide_px, &error);
+  pool.release(h);
+  if (!ok) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
+    return 1;
+  }
+  std::printf("{\"out\": \"%s\", \"width\": %d, \"height\": %d, \"sequence\": %u, \"fx\": %.3f, \"cx\": %.3f, "
+              "\"cy\": %.3f, \"baseline_m\": %.5f}\n",
+              out_path.c_str(), f.width, f.height, f.sequence, r.fx, r.cx, r.cy, r.baseline_m);
+  return 0;
+}
+
+// The pair after `skip` others from the recorded frames of a camera,
+// through the same driver: what rtfused rectified while it recorded.
+int from_recording(const std::string& log_path, const std::string& out_path, int guide_px, int skip) {
+  rtfuse::transport::EventLogReader in;
+  rtfuse::transport::HalRecording rec;
+  std::string error;
+  rtfuse::transport::HalRecordingOptions options;
+  options.allow_truncated = true;  // a killed recorder's frames are still frames
+  if (!in.open(log_path, &error) || !rtfuse::transport::load_hal_recording(in, options, &rec, &error)) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
+    return 1;
+  }
+  const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(rec.info.config_text, rec.info.config_path);
+  if (!loaded.config) {
+    for (const auto& e : loaded.errors) std::fprintf(stderr, "%s\n", e.to_string().c_str());
+    return 2;
+  }
+  rtfuse::CameraSection camera = loaded.config->hardware.camera;
+  for (const rtfuse::transport::RecordedFile& f : rec.info.files) {
+    if (f.key == rtfuse::kCameraCalibrationKey) camera.calibration_text = f.text;
+  }
+  int stream = -1, device = -1;
+  for (std::size_t d = 0; d < rec.info.devices.size(); ++d) {
+    if (rec.info.devices[d].kind != rtfuse::transport::DeviceKind::kVideo) continue;
+    stream = rec.info.devices[d].stream;
+    device = static_cast<int>(d);
+    break;
+  }
+  if (!camera.enabled || stream < 0) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: %s holds no camera frames (its config has %s[camera])\n",
+                 log_path.c_str(), camera.enabled ? "a " : "no ");
+    return 2;
+  }
+  rtfuse::hal::replay::ReplayVideoLog& log = *rec.videos[static_cast<std::size_t>(stream)];
+  rtfuse::hal::replay::ReplayVideoStream video(log, static_cast<std::uint8_t>(device));
+  rtfuse::hal::mock::SimClock clock(rec.info.start_ns);
+  rtfuse::drivers::StereoCameraConfig dcfg;
+  if (!rtfuse::camera_driver_config(camera, &dcfg, &error)) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
+    return 1;
+  }
+  rtfuse::FramePool pool(camera.pool_frames, dcfg.calibration.width, dcfg.calibration.height);
+  auto driver = rtfuse::drivers::StereoCamera::create(dcfg, video, clock, pool, &error);
+  if (!driver) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
+    return 1;
+  }
+  const std::int64_t want = (skip < 0 ? 0 : skip) + 1;
+  rtfuse::drivers::StereoFrameResult r;
+  for (std::size_t k = 0; k < 2 * log.size() + 16 && !log.at_end() && !log.diverged() &&
+                          driver->stats().rectified < want;
+       ++k) {
+    driver->step(rtfuse::kDeviceStepTimeoutNs, &r);
+    // The newest pair is the one to keep; older ones go back to the pool.
+    if (driver->stats().rectified < want) {
+      rtfuse::FramePool::Handle h = pool.take_latest();
+      if (h.valid()) pool.release(h);
+    }
+  }
+  return write_pair(pool, driver->rectified(), driver->stats(), out_path, guide_px);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -36,16 +127,26 @@ int main(int argc, char** argv) {
   int guide_px = 24;
   int skip = 5;
   double at_s = 5.0;
-  app.add_option("-c,--config", config_path, "robot config (TOML) with a [camera]")->required();
+  std::string recording_path;
+  auto* config_opt = app.add_option("-c,--config", config_path, "robot config (TOML) with a [camera]");
+  auto* recording_opt =
+      app.add_option("-r,--recording", recording_path, "an rtfused --record log with camera frames instead of a camera");
+  config_opt->excludes(recording_opt);
+  recording_opt->excludes(config_opt);
   app.add_option("-o,--out", out_path, "PNG to write (default stereo_pair.png)");
   app.add_option("-g,--guide", guide_px, "a guide line every N rows (0: none; default 24)");
-  app.add_option("-n,--skip", skip, "frames to let pass first, while exposure settles (default 5)");
+  app.add_option("-n,--skip", skip, "frames to let pass first, while exposure settles (default 5; of a recording: its first N)");
   app.add_option("-s,--scenario", scenario_path, "simulated robot: drive scenario (default: the config's)");
   app.add_option("-t,--time", at_s, "simulated robot: seconds into the drive (default 5)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  if (!recording_path.empty()) return from_recording(recording_path, out_path, guide_px, skip);
+  if (config_path.empty()) {
+    std::fprintf(stderr, "rtfuse-camera-snapshot: give the camera's config (--config) or a recording (--recording)\n");
+    return 2;
   }
   const rtfuse::ConfigLoadResult loaded = rtfuse::load_config_file(config_path);
   if (!loaded.config) {
@@ -94,24 +195,5 @@ int main(int argc, char** argv) {
   const std::int64_t want = (skip < 0 ? 0 : skip) + 1;
   // Ten seconds of steps at most: a camera that gives nothing is reported.
   for (int k = 0; k < 200 && camera.samples() < want; ++k) camera.step(rtfuse::kDeviceStepTimeoutNs);
-  rtfuse::FramePool::Handle h = camera.pool().take_latest();
-  if (!h.valid()) {
-    const auto& st = camera.stats();
-    std::fprintf(stderr, "rtfuse-camera-snapshot: no frame from the camera (%lld dequeued, %lld timeouts, %lld rejected): %s\n",
-                 static_cast<long long>(st.frames), static_cast<long long>(st.stream.timeouts),
-                 static_cast<long long>(st.rejected_size + st.rejected_corrupted), st.last_error);
-    return 1;
-  }
-  const rtfuse::FramePool::Frame f = camera.pool().frame(h);
-  const bool ok = rtfuse::apps::write_stereo_png(out_path, f.left, f.right, f.width, f.height, f.stride, guide_px, &error);
-  camera.pool().release(h);
-  if (!ok) {
-    std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
-    return 1;
-  }
-  const rtfuse::drivers::StereoRectification& r = camera.rectified();
-  std::printf("{\"out\": \"%s\", \"width\": %d, \"height\": %d, \"sequence\": %u, \"fx\": %.3f, \"cx\": %.3f, "
-              "\"cy\": %.3f, \"baseline_m\": %.5f}\n",
-              out_path.c_str(), f.width, f.height, f.sequence, r.fx, r.cx, r.cy, r.baseline_m);
-  return 0;
+  return write_pair(camera.pool(), camera.rectified(), camera.stats(), out_path, guide_px);
 }

@@ -42,6 +42,14 @@ void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::Snapshot& s, std
                 st.rejected_mahalanobis, st.rejected_invalid, st.rejected_stale, st.rejected_overflow,
                 st.decode_errors, st.yaw_conflicts);
   }
+  // Device health at the end (a HAL recording's): what rtfused prints when it stops.
+  std::printf("}, \"devices\": {");
+  for (int i = 0; i < s.num_devices; ++i) {
+    const rtfuse::DeviceStatus& d = s.devices[i];
+    std::printf("%s\"%s\": {\"state\": \"%s\"", i ? ", " : "", d.name.c_str(), d.state.c_str());
+    for (int k = 0; k < d.num_values; ++k) std::printf(", \"%s\": %" PRId64, d.keys[k], d.values[k]);
+    std::printf("}");
+  }
   std::printf("}%s}\n", extra.c_str());
 }
 

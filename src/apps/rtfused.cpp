@@ -19,6 +19,7 @@
 #include <CLI/CLI.hpp>
 
 #include "hal/linux/monotonic_clock.hpp"
+#include "runtime/camera_calibration.hpp"
 #include "runtime/config_loader.hpp"
 #include "runtime/linux_hal.hpp"
 #include "runtime/loop_timer.hpp"
@@ -35,6 +36,7 @@
 namespace rtfuse::apps {
 extern const std::string_view kEmbeddedSimConfig;
 extern const std::string_view kEmbeddedDemoScenario;
+extern const std::string_view kEmbeddedCameraCalibration;
 }
 
 // Optional hook for the allocation probe (tests/system/alloc_probe.c, loaded
@@ -119,6 +121,16 @@ int main(int argc, char** argv) {
   }
   rtfuse::RuntimeConfig cfg = *loaded.config;
   if (!lcm_url.empty()) cfg.lcm_url = lcm_url;
+  if (cfg.hardware.camera.enabled) {
+    std::string why;
+    // The embedded config's camera is the one of the embedded calibration;
+    // any other is read here, once, so a missing file stops before anything runs.
+    if (config_path.empty()) cfg.hardware.camera.calibration_text = rtfuse::apps::kEmbeddedCameraCalibration;
+    if (!rtfuse::resolve_camera_calibration(&cfg.hardware.camera, &why)) {
+      std::fprintf(stderr, "rtfused: camera.calibration: %s\n", why.c_str());
+      return 2;
+    }
+  }
 
   std::string error;
   rtfuse::HalBuses buses;
@@ -215,12 +227,22 @@ int main(int argc, char** argv) {
     next_status = now + (tty ? 250'000'000 : 5'000'000'000);
     char err_text[32] = "";
     if (!std::isnan(last_error)) std::snprintf(err_text, sizeof(err_text), " | err %.3f m", last_error);
-    char line[256];
+    // The rate of every device that measures one (the camera's, from its capture stamps).
+    char rates[96] = "";
+    for (int i = 0, at = 0; i < s.num_devices; ++i) {
+      const rtfuse::DeviceStatus& d = s.devices[i];
+      for (int k = 0; k < d.num_values && at < static_cast<int>(sizeof rates); ++k) {
+        if (std::strcmp(d.keys[k], "fps_milli") != 0) continue;
+        at += std::snprintf(rates + at, sizeof rates - static_cast<std::size_t>(at), " | %s %.1f fps", d.name.c_str(),
+                            static_cast<double>(d.values[k]) / 1000.0);
+      }
+    }
+    char line[320];
     std::snprintf(line, sizeof(line),
-                  "t=%6.1fs loop %.0f Hz overruns %lld jitter max %.0f us | x %.2f y %.2f yaw %.2f | fused %lld%s",
+                  "t=%6.1fs loop %.0f Hz overruns %lld jitter max %.0f us | x %.2f y %.2f yaw %.2f | fused %lld%s%s",
                   rtfuse::ns_to_sec(now - start), s.loop.rate_hz, static_cast<long long>(s.loop.overruns),
                   s.loop.jitter_max_ns / 1e3, s.state[0], s.state[1], s.state[5],
-                  static_cast<long long>(s.loop.measurements_fused), err_text);
+                  static_cast<long long>(s.loop.measurements_fused), rates, err_text);
     std::fprintf(stderr, tty ? "\r%s\033[K" : "%s\n", line);
   }
   if (probe_armed) rtfuse_alloc_probe_steady(0);
@@ -236,7 +258,8 @@ int main(int argc, char** argv) {
   for (int i = 0; i < s.num_devices; ++i) {
     const rtfuse::DeviceStatus& d = s.devices[i];
     std::printf("rtfused: device %s (%s): %s", d.name.c_str(), d.hardware_id.c_str(), d.state.c_str());
-    for (int k = 0; k < d.num_values && k < 3; ++k) std::printf(", %s %lld", d.keys[k], static_cast<long long>(d.values[k]));
+    for (int k = 0; k < d.num_values; ++k) std::printf(", %s %lld", d.keys[k], static_cast<long long>(d.values[k]));
+    if (!d.message.empty()) std::printf("; last error: %s", d.message.c_str());
     std::printf("\n");
   }
   if ((sim || robot) && err_samples > 0) {

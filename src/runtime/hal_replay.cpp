@@ -11,6 +11,7 @@
 #include "hal/replay/replay_gpio.hpp"
 #include "hal/replay/replay_i2c_bus.hpp"
 #include "hal/replay/replay_video_stream.hpp"
+#include "runtime/camera_calibration.hpp"
 #include "runtime/recording_tap.hpp"
 #include "runtime/tick_pipeline.hpp"
 
@@ -140,10 +141,16 @@ std::string check_recording_config(const transport::RecordingInfo& info, const s
          "); leave out --config to replay with the configuration stored in the recording";
 }
 
-HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const RuntimeConfig& cfg,
+HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const RuntimeConfig& given,
                                      transport::EventLogWriter* out,
                                      const std::function<void(const HalReplayProgress&)>& progress) {
   HalReplayResult result;
+  // The calibration the camera had, from the recording, not from a file on
+  // this machine that may differ or be missing.
+  RuntimeConfig cfg = given;
+  for (const transport::RecordedFile& f : rec.info.files) {
+    if (f.key == kCameraCalibrationKey && cfg.hardware.camera.enabled) cfg.hardware.camera.calibration_text = f.text;
+  }
   const int loop = stream_index(rec.info, kLoopStream);
   const int imu = stream_index(rec.info, kImuStream);
   std::vector<std::unique_ptr<hal::CanBus>> cans;

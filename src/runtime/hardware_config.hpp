@@ -93,6 +93,10 @@ struct CameraSection {
   bool enabled = false;
   HwName device{"/dev/video0"};
   std::string calibration_file;  // the factory SN<serial>.conf (resolved path)
+  // The calibration file's bytes when they come from elsewhere than the file
+  // (the embedded config's, a recording's), or once read at start-up (see
+  // runtime/camera_calibration.hpp); "" = read calibration_file.
+  std::string calibration_text;
   std::int64_t serial = 0;       // 0: any; else the file must be this camera's
   HwName resolution{"VGA"};      // 2K, FHD, HD, VGA
   int fps = 30;

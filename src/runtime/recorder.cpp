@@ -49,6 +49,10 @@ std::unique_ptr<Recorder> Recorder::create(const std::string& path, transport::R
   }
   const std::vector<std::uint8_t> bytes = transport::encode_recording_info(rec->info_);
   rec->write(ns_to_utime(rec->info_.start_ns), transport::kRecordingInfoChannel, bytes.data(), bytes.size());
+  for (const transport::RecordedFile& f : rec->info_.files) {
+    const std::vector<std::uint8_t> file = transport::encode_recorded_file(f);
+    rec->write(ns_to_utime(rec->info_.start_ns), transport::kRecordedFileChannel, file.data(), file.size());
+  }
   // On disk at once: a recorder killed before its first flush still leaves a
   // file that says what it is.
   if (rec->write_errors_.load() > 0 || !rec->writer_.flush(&why)) {

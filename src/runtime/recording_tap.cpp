@@ -2,6 +2,8 @@
 
 #include <algorithm>
 
+#include "runtime/camera_calibration.hpp"
+
 namespace rtfuse {
 namespace {
 
@@ -36,6 +38,11 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
   info.config_text = config_text;
   info.config_hash = transport::config_text_hash(config_text);
   info.streams = {kLoopStream, kImuStream};
+  // The calibration travels with the recording: its replay needs no file.
+  const CameraSection& camera_section = cfg.hardware.camera;
+  if (camera_section.enabled && !camera_section.calibration_text.empty()) {
+    info.files.push_back({kCameraCalibrationKey, camera_section.calibration_file, camera_section.calibration_text});
+  }
   // The camera's calls go through a ring of their own (frames are large), on
   // a stream of their own; a configuration without one records as before.
   if (inner.camera.video != nullptr) info.streams.push_back(kCameraStream);

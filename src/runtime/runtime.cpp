@@ -103,6 +103,7 @@ bool Runtime::stop(std::string* error) {
   for (std::thread& t : devices_) {
     if (t.joinable()) t.join();
   }
+  stopped_.store(true);
   // Producers are gone: the recorder drains what is left and closes.
   return pipeline_ ? pipeline_->stop(error) : true;
 }
@@ -110,6 +111,10 @@ bool Runtime::stop(std::string* error) {
 Snapshot Runtime::latest() const {
   Snapshot s;
   pipeline_->core().snapshot().load(s);
+  // With every thread joined, the devices' own final health replaces the
+  // last tick's view of it (a camera's frames after that tick), as a replay
+  // ends with: the two can then be compared.
+  if (stopped_.load() && pipeline_->hardware() != nullptr) pipeline_->hardware()->fill_snapshot(s);
   return s;
 }
 

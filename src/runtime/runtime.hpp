@@ -52,6 +52,7 @@ class Runtime {
   // if it could not be written completely).
   bool stop(std::string* error = nullptr);
 
+  // The last tick's snapshot; after stop(), with the devices' final health.
   Snapshot latest() const;
   transport::LcmNode& lcm() { return *lcm_; }
   const RuntimeConfig& config() const { return pipeline_->config(); }
@@ -92,6 +93,7 @@ class Runtime {
   PublishJob job_;  // the loop's staging copy
   std::atomic<std::int64_t> publish_drops_{0};
   std::atomic<bool> running_{false};
+  std::atomic<bool> stopped_{false};  // stop() joined every thread
   std::atomic<bool> steady_{false};
   std::atomic<bool> rt_failed_{false};
   std::string rt_warnings_;

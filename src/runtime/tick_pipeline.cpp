@@ -1,5 +1,7 @@
 #include "runtime/tick_pipeline.hpp"
 
+#include "runtime/camera_calibration.hpp"
+
 namespace rtfuse {
 
 TickPipeline::~TickPipeline() = default;
@@ -7,7 +9,13 @@ TickPipeline::~TickPipeline() = default;
 std::unique_ptr<TickPipeline> TickPipeline::create(const RuntimeConfig& cfg, const HalBuses& buses_in,
                                                    const PipelineOptions& options, std::string* error) {
   std::unique_ptr<TickPipeline> p(new TickPipeline());
-  p->core_ = FusionCore::create(cfg, error);
+  // The camera's calibration is read once, here: the driver and the
+  // recording then hold the same bytes.
+  RuntimeConfig resolved = cfg;
+  if (resolved.hardware.camera.enabled && !resolve_camera_calibration(&resolved.hardware.camera, error)) {
+    return nullptr;
+  }
+  p->core_ = FusionCore::create(resolved, error);
   if (!p->core_) return nullptr;
   HalBuses buses = buses_in;
   if (!options.record_path.empty()) {

@@ -3,8 +3,8 @@
 #include <cmath>
 
 #include "drivers/camera/camera_modes.hpp"
-#include "drivers/camera/zed_calibration.hpp"
 #include "geometry/frame_tree.hpp"
+#include "runtime/camera_calibration.hpp"
 
 namespace rtfuse::sim {
 
@@ -13,11 +13,9 @@ std::unique_ptr<SimCamera> SimCamera::create(const RuntimeConfig& cfg, const Tru
   const CameraSection& c = cfg.hardware.camera;
   drivers::CameraMode mode;
   if (!drivers::find_camera_mode(c.resolution.view(), c.fps, &mode, error)) return nullptr;
-  drivers::ZedResolution resolution;
-  drivers::parse_resolution(c.resolution.view(), &resolution);
   drivers::ZedCalibration calibration;
   // The simulated camera is the one the calibration describes.
-  if (!drivers::load_zed_calibration(c.calibration_file, resolution, 0, &calibration, error)) return nullptr;
+  if (!load_camera_calibration(c, 0, &calibration, error)) return nullptr;
   geometry::FrameTree frames;
   frames.intern(cfg.base_link_frame.view());
   for (int i = 0; i < cfg.num_static_transforms; ++i) {

@@ -11,6 +11,7 @@
 #include "rtfuse/hal_i2c_t.hpp"
 #include "rtfuse/hal_video_t.hpp"
 #include "rtfuse/loop_tick_t.hpp"
+#include "rtfuse/recording_file_t.hpp"
 #include "rtfuse/recording_info_t.hpp"
 #include "transport/encode_buffer.hpp"
 
@@ -132,6 +133,24 @@ std::int64_t config_text_hash(std::string_view text) noexcept {
   return static_cast<std::int64_t>(h);
 }
 
+namespace {
+
+bool valid_file(const RecordedFile& f, std::string* error) {
+  if (f.key.empty() || f.key.size() > kMaxRecordedFileKeyLength || f.path.size() > kMaxRecordedFilePathLength ||
+      f.text.size() > kMaxRecordedFileBytes) {
+    set_error(error, "recorded file '" + f.key.substr(0, kMaxRecordedFileKeyLength) + "': key of " +
+                         std::to_string(f.key.size()) + " characters (1.." +
+                         std::to_string(kMaxRecordedFileKeyLength) + "), path of " + std::to_string(f.path.size()) +
+                         " (at most " + std::to_string(kMaxRecordedFilePathLength) + "), " +
+                         std::to_string(f.text.size()) + " bytes (at most " + std::to_string(kMaxRecordedFileBytes) +
+                         ")");
+    return false;
+  }
+  return true;
+}
+
+}  // namespace
+
 bool validate(const RecordingInfo& info, std::string* error) {
   const auto n_streams = static_cast<int>(info.streams.size());
   if (n_streams < 1 || n_streams > kMaxRecordedStreams) {
@@ -174,6 +193,21 @@ bool validate(const RecordingInfo& info, std::string* error) {
         set_error(error, where + ": stream '" + info.streams[static_cast<std::size_t>(d.stream)] +
                              "' has video and non-video devices (device " + std::to_string(j) +
                              " '" + info.devices[j].name + "'); a camera needs a stream of its own");
+        return false;
+      }
+    }
+  }
+  if (info.files.size() > static_cast<std::size_t>(kMaxRecordedFiles)) {
+    set_error(error, "recording info: " + std::to_string(info.files.size()) + " files (at most " +
+                         std::to_string(kMaxRecordedFiles) + ")");
+    return false;
+  }
+  for (std::size_t i = 0; i < info.files.size(); ++i) {
+    const RecordedFile& f = info.files[i];
+    if (!valid_file(f, error)) return false;
+    for (std::size_t j = 0; j < i; ++j) {
+      if (info.files[j].key == f.key) {
+        set_error(error, "recording info: two files for '" + f.key + "'");
         return false;
       }
     }
@@ -240,6 +274,45 @@ bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::
   }
   if (!validate(info, error)) return false;
   *out = std::move(info);
+  return true;
+}
+
+std::vector<std::uint8_t> encode_recorded_file(const RecordedFile& file) {
+  rtfuse::recording_file_t m;
+  m.key = file.key;
+  m.path = file.path;
+  m.size = static_cast<std::int32_t>(file.text.size());
+  m.data.assign(file.text.begin(), file.text.end());
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+bool decode_recorded_file(const void* data, int size, RecordedFile* out, std::string* error) {
+  const auto* b = static_cast<const std::uint8_t*>(data);
+  // Both strings and the byte count bounded before lcm-gen's decoder sizes
+  // anything from them (see after_device_string).
+  int at = 8;
+  for (const std::size_t max : {kMaxRecordedFileKeyLength, kMaxRecordedFilePathLength}) {
+    if (b == nullptr || size - at < 4) break;
+    const std::int32_t len = load_i32(b + at);
+    if (len < 1 || static_cast<std::size_t>(len) > max + 1 || len > size - at - 4) {
+      set_error(error, "malformed recording_file_t: a string length of " + std::to_string(len) + " at byte " +
+                           std::to_string(at));
+      return false;
+    }
+    at += 4 + len;
+  }
+  if (b == nullptr || !count_within(b, size, at, static_cast<int>(kMaxRecordedFileBytes))) {
+    set_error(error, "malformed recording_file_t: too short, or more than " + std::to_string(kMaxRecordedFileBytes) +
+                         " bytes");
+    return false;
+  }
+  rtfuse::recording_file_t m;
+  if (!decode_message(m, data, size, "recording_file_t", error)) return false;
+  RecordedFile f{m.key, m.path, std::string(m.data.begin(), m.data.end())};
+  if (!valid_file(f, error)) return false;
+  *out = std::move(f);
   return true;
 }
 
@@ -821,6 +894,11 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
       have_tick = true;
       last_seq = tick.seq;
       rec.ticks.push_back(std::move(tick));
+    } else if (ev.channel == kRecordedFileChannel) {
+      RecordedFile file;
+      if (!decode_recorded_file(ev.data, size, &file, &why)) return undecodable(ev, why);
+      rec.info.files.push_back(std::move(file));
+      if (!validate(rec.info, &why)) return undecodable(ev, why);
     } else if (starts_with(ev.channel, kRecordChannelPrefix)) {
       return undecodable(ev, ev.channel == kRecordingInfoChannel
                                  ? std::string("a second recording_info_t (two recordings concatenated?)")

@@ -35,6 +35,7 @@ constexpr std::int32_t kHalRecordFormatVersion = 2;
 
 constexpr std::string_view kRecordingInfoChannel = "rtfuse/rec/info";
 constexpr std::string_view kLoopTickChannel = "rtfuse/rec/tick";
+constexpr std::string_view kRecordedFileChannel = "rtfuse/rec/file";
 constexpr std::string_view kRecordChannelPrefix = "rtfuse/rec/";
 constexpr std::string_view kHalChannelPrefix = "rtfuse/hal/";
 
@@ -64,6 +65,18 @@ struct RecordedDevice {
   int stream = 0;  // index into RecordingInfo::streams of the thread that uses it
 };
 
+// A file the configuration refers to, carried by the recording
+// (recording_file_t): the camera's calibration.
+struct RecordedFile {
+  std::string key;   // the config key naming it: "camera.calibration"
+  std::string path;  // where it was read from
+  std::string text;  // its bytes
+};
+constexpr int kMaxRecordedFiles = 8;
+constexpr std::size_t kMaxRecordedFileKeyLength = 64;
+constexpr std::size_t kMaxRecordedFilePathLength = 4096;
+constexpr std::size_t kMaxRecordedFileBytes = 1024 * 1024;
+
 struct RecordingInfo {
   std::int32_t format_version = kHalRecordFormatVersion;
   TimeNs start_ns = 0;
@@ -73,6 +86,8 @@ struct RecordingInfo {
   std::int64_t config_hash = 0;  // config_text_hash(config_text)
   std::vector<std::string> streams;  // producing threads: "loop", "imu"
   std::vector<RecordedDevice> devices;  // index = hal::BusEvent::device
+  // Written as rtfuse/rec/file events after the recording_info_t.
+  std::vector<RecordedFile> files;
 };
 
 // FNV-1a (64-bit) of the config text.
@@ -80,13 +95,18 @@ std::int64_t config_text_hash(std::string_view text) noexcept;
 
 // Device names non-empty, at most kMaxDeviceNameLength, unique, without '/'
 // or spaces; stream indices valid; counts within the limits above; a video
-// device's stream holds only video devices.
+// device's stream holds only video devices; files within their limits, keys
+// unique.
 bool validate(const RecordingInfo& info, std::string* error);
 
 std::vector<std::uint8_t> encode_recording_info(const RecordingInfo& info);
 // Fails on bytes that are not a recording_info_t, on another format version
 // (named, with the fix), and on an invalid device table.
 bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::string* error);
+
+std::vector<std::uint8_t> encode_recorded_file(const RecordedFile& file);
+// Fails on bytes that are not a recording_file_t or exceed the limits above.
+bool decode_recorded_file(const void* data, int size, RecordedFile* out, std::string* error);
 
 struct LoopTick {
   TimeNs time_ns = 0;

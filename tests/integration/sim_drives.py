@@ -9,8 +9,10 @@
                     hurts the wheels, below raw wheel odometry's);
   replay_exact      the recording of a drive replays through the drivers with
                     every estimate output byte-identical, twice the same;
-  live_record       rtfused recording a live run (real threads, real clock)
-                    replays byte-identically too;
+  live_record       rtfused recording a live run (real threads, real clock,
+                    the simulated stereo camera) replays byte-identically
+                    too, every rectified pair included, with the calibration
+                    the recording carries;
   divergence        a recording whose NMT start frame was altered stops the
                     replay with a report naming the event;
   bad_recordings    another config, a truncated file, a plain log without a
@@ -191,15 +193,63 @@ def check_cross_arch(tmp):
             sys.exit(f"FAIL: {name}: {rec['outputs_identical']} of {rec['outputs_compared']} outputs identical")
 
 
+def device_lines(stdout):
+    """rtfused's end-of-run device lines: {name: {key: value}}."""
+    devices = {}
+    for line in stdout.splitlines():
+        if not line.startswith("rtfused: device "):
+            continue
+        head, _, rest = line[len("rtfused: device "):].partition("): ")
+        name = head.rsplit(" (", 1)[0]
+        fields = rest.split("; last error: ")[0].split(", ")
+        devices[name] = {"state": fields[0], **{k: int(v) for k, v in (f.rsplit(" ", 1) for f in fields[1:])}}
+    return devices
+
+
 def check_live_record(tmp):
+    """rtfused on the embedded config (encoders, IMU and the simulated stereo
+    camera) records a live run; the replay reproduces every estimate output
+    and every rectified pair (the camera's digest of them, its frame count
+    and all its counters); the calibration travels in the recording."""
     log = os.path.join(tmp, "live.lcm")
-    p = run([RTFUSED, "--duration", "3", "--quiet", "--lcm-url", "memq://", "--record", log])
+    p = run([RTFUSED, "--duration", "3", "--lcm-url", "memq://", "--record", log])
     if p.returncode != 0:
         sys.exit(f"FAIL: rtfused --record: exit {p.returncode}\n{p.stdout}{p.stderr}")
-    rec = replay_json(log)["recording"]
+    live = device_lines(p.stdout).get("camera")
+    result = replay_json(log)
+    rec = result["recording"]
     print(json.dumps(rec))
     if rec["outputs_compared"] < 200 or rec["outputs_identical"] != rec["outputs_compared"]:
         sys.exit(f"FAIL: live recording: {rec['outputs_identical']} of {rec['outputs_compared']} outputs identical")
+    replayed = result["devices"].get("camera")
+    print(f"camera live: {live}\ncamera replayed: {replayed}")
+    if not live or live.get("frames", 0) < 1:
+        sys.exit(f"FAIL: the live camera rectified no pair: {p.stdout}")
+    if replayed != live:
+        sys.exit("FAIL: the replayed camera differs from the live one (frames, digest of the rectified pairs or counters)")
+
+    # A config of its own, whose calibration file is gone when it replays.
+    robot = os.path.join(tmp, "robot")
+    os.makedirs(os.path.join(robot, "calibration"))
+    with open(os.path.join(SRC, "config", "sim.toml")) as f:
+        text = f.read().replace('scenario = "scenarios/demo.toml"',
+                                'scenario = "%s"' % os.path.join(SRC, "config", "scenarios", "straight.toml"))
+    with open(os.path.join(robot, "sim.toml"), "w") as f:
+        f.write(text)
+    calibration = os.path.join(robot, "calibration", "SN10000001.conf")
+    with open(os.path.join(SRC, "config", "calibration", "SN10000001.conf")) as f, open(calibration, "w") as g:
+        g.write(f.read())
+    log = os.path.join(tmp, "own.lcm")
+    p = run([RTFUSED, "--config", os.path.join(robot, "sim.toml"), "--duration", "1", "--quiet",
+             "--lcm-url", "memq://", "--record", log])
+    if p.returncode != 0:
+        sys.exit(f"FAIL: rtfused --config robot/sim.toml --record: exit {p.returncode}\n{p.stdout}{p.stderr}")
+    live = device_lines(p.stdout).get("camera")
+    os.remove(calibration)
+    result = replay_json(log)
+    if result["devices"].get("camera") != live or result["recording"]["outputs_identical"] == 0:
+        sys.exit(f"FAIL: without its calibration file: {result['devices'].get('camera')} vs live {live}")
+    print("replayed with the recorded calibration, its file removed:", result["devices"]["camera"]["frames"], "pairs")
 
 
 def check_divergence(tmp):

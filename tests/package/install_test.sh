@@ -8,7 +8,8 @@
 #   - the configs in /etc/rtfuse, registered as conffiles; the unit enabled
 #     (multi-user.target.wants) and not started;
 #   - every NEEDED library of the programs comes from a package in Depends;
-#   - rtfused --version, the shipped rtfused.toml loading (it then stops at
+#   - rtfused --version, the other programs' --help (rtfuse-replay,
+#     rtfuse-sim, rtfuse-camera-snapshot), the shipped rtfused.toml loading (it then stops at
 #     the missing CAN bus), a 2 s simulated run as user rtfuse, and
 #     rtfuse-sim driving scenarios/straight.toml within the bounds of
 #     tests/integration/sim_drives.py;
@@ -129,7 +130,7 @@ IFS=: read -r _ _ uid gid _ home shell <<<"$pw"
 [[ $(in_root stat -c %U /var/lib/rtfuse) == rtfuse ]] || die "/var/lib/rtfuse is not owned by rtfuse"
 
 conffiles=$(in_root dpkg-query --control-show rtfuse conffiles)
-for f in "$src"/config/*.toml "$src"/config/scenarios/*.toml rtfused.toml; do
+for f in "$src"/config/*.toml "$src"/config/scenarios/*.toml "$src"/config/calibration/*.conf rtfused.toml; do
   rel=${f#"$src"/config/}
   [[ -f $work/etc/rtfuse/$rel ]] || die "/etc/rtfuse/$rel not installed"
   grep -qx "/etc/rtfuse/$rel" <<<"$conffiles" || die "/etc/rtfuse/$rel is not a conffile (dpkg-query --control-show rtfuse conffiles)"
@@ -142,7 +143,7 @@ wants=$work/etc/systemd/system/multi-user.target.wants/rtfused.service
 # --- libraries: each NEEDED one from a package in Depends ----------------
 depends=$(in_root dpkg-query -W -f='${Depends}' rtfuse)
 dep_names=$(tr ',' '\n' <<<"$depends" | sed -E 's/^ +//; s/[ (:].*//' | sort -u)
-for prog in rtfused rtfuse-replay rtfuse-sim; do
+for prog in rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot; do
   while read -r so; do
     owner=""
     for dir in "/lib/$triplet" "/usr/lib/$triplet" /lib /usr/lib; do
@@ -160,7 +161,7 @@ done
 out=$(in_root /usr/bin/rtfused --version) || die "rtfused --version failed in the $arch root: $out"
 [[ $out == "rtfused $version" ]] || die "rtfused --version printed '$out', expected 'rtfused $version'"
 note "rtfused --version: $out"
-for prog in rtfuse-replay rtfuse-sim; do
+for prog in rtfuse-replay rtfuse-sim rtfuse-camera-snapshot; do
   in_root "/usr/bin/$prog" --help >/dev/null || die "$prog --help failed in the $arch root"
 done
 

@@ -25,6 +25,7 @@ run_case() {  # name lock priority require expected-exit expected-message...
   local cfg=$work/$name.toml
   cp "$src/config/sim.toml" "$cfg"
   [[ -d $work/scenarios ]] || cp -r "$src/config/scenarios" "$work/"  # the config's drive, relative to it
+  [[ -d $work/calibration ]] || cp -r "$src/config/calibration" "$work/"  # and its camera's calibration
   printf '\n[realtime]\nlock_memory = %s\npriority = %s\nrequire = %s\n' "$lock" "$prio" "$require" >> "$cfg"
   set +e
   (ulimit -r 0; ulimit -l 64; "${drop[@]}" "$rtfused" --config "$cfg" --duration 1 --quiet --lcm-url memq://) \

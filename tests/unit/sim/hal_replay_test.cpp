@@ -22,6 +22,7 @@
 #include "sim/simulated_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
+#include "support/sim_toml.hpp"
 
 namespace rtfuse {
 namespace {
@@ -64,7 +65,7 @@ class HalReplay : public testing::Test {
     }
     std::ofstream(*scenario_path_) << scenario;
 
-    config_text_ = new std::string(read_text(kSimToml));
+    config_text_ = new std::string(test::sim_toml_text(false));
     const ConfigLoadResult c = load_config_string(*config_text_, kSimToml);
     for (const auto& e : c.errors) ADD_FAILURE() << e.to_string();
     ASSERT_TRUE(c.ok());

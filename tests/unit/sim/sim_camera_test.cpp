@@ -24,6 +24,7 @@
 #include "sim/simulated_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
+#include "support/sim_toml.hpp"
 
 namespace {
 
@@ -31,27 +32,17 @@ using namespace rtfuse;  // NOLINT
 
 const std::string kSimToml = std::string(RTFUSE_SOURCE_DIR) + "/config/sim.toml";
 
-// The left eye 0.3 m up at the front, looking forward: the optical frame's
-// z is base_link's x, its x is -y, its y is -z.
+// sim.toml's own camera; its mount (the left eye 0.3 m up at the front,
+// looking forward) stays in the config when the table is taken out.
 constexpr const char* kCamera = R"(
 [camera]
 calibration = "calibration/SN10000001.conf"
 resolution = "VGA"
 fps = 30
-
-[[static_transform]]
-parent = "base_link"
-child = "camera_optical"
-translation = [0.2, 0.06, 0.3]
-rpy = [-1.5707963267948966, 0.0, -1.5707963267948966]
 )";
 
-std::string sim_toml() {
-  std::ifstream in(kSimToml);
-  std::stringstream ss;
-  ss << in.rdbuf();
-  return ss.str();
-}
+// sim.toml without its [camera], which each test here writes itself.
+std::string sim_toml() { return test::sim_toml_text(false); }
 
 ConfigLoadResult load(const std::string& extra) {
   // Named after config/sim.toml so its relative paths (scenario, calibration) resolve from config/.
@@ -125,7 +116,14 @@ TEST(SimCamera, RecordedFramesReplayThroughTheDriver) {
   transport::HalRecording rec;
   ASSERT_TRUE(transport::load_hal_recording(reader, {}, &rec, &err)) << err;
   EXPECT_EQ(rec.lost_frames, 0);
-  const HalReplayResult replay = replay_hal_recording(rec, *r.config, nullptr, nullptr);
+  // The calibration travels in the recording: the replay uses it even where
+  // the file the config names does not exist.
+  ASSERT_EQ(rec.info.files.size(), 1u);
+  EXPECT_EQ(rec.info.files[0].key, "camera.calibration");
+  EXPECT_EQ(rec.info.files[0].path, std::string(RTFUSE_SOURCE_DIR) + "/config/calibration/SN10000001.conf");
+  RuntimeConfig elsewhere = *r.config;
+  elsewhere.hardware.camera.calibration_file = "/nonexistent/SN10000001.conf";
+  const HalReplayResult replay = replay_hal_recording(rec, elsewhere, nullptr, nullptr);
   std::remove(path.c_str());
   ASSERT_TRUE(replay.ok) << replay.error;
   EXPECT_FALSE(replay.ended_early) << replay.note;
@@ -135,6 +133,9 @@ TEST(SimCamera, RecordedFramesReplayThroughTheDriver) {
   ASSERT_NE(replayed, nullptr);
   EXPECT_EQ(value(*replayed, "frames"), value(*live, "frames"));
   EXPECT_GT(value(*replayed, "frames"), 500);
+  // The same pairs, pixel for pixel, in the same order.
+  EXPECT_EQ(value(*replayed, "pairs_digest"), value(*live, "pairs_digest"));
+  EXPECT_NE(value(*live, "pairs_digest"), 0);
   EXPECT_EQ(value(*replayed, "rejected_size"), 0);
 }
 

@@ -18,6 +18,7 @@
 #include <gtest/gtest.h>
 
 #include "runtime/config_loader.hpp"
+#include "support/sim_toml.hpp"
 
 namespace rtfuse::sim {
 namespace {
@@ -26,7 +27,7 @@ const std::string kSimToml = RTFUSE_SOURCE_DIR "/config/sim.toml";
 const std::string kStraight = RTFUSE_SOURCE_DIR "/config/scenarios/straight.toml";
 
 RuntimeConfig load_sim_toml() {
-  const ConfigLoadResult r = load_config_file(kSimToml);
+  const ConfigLoadResult r = load_config_string(test::sim_toml_text(false), kSimToml);
   for (const auto& e : r.errors) ADD_FAILURE() << e.to_string();
   return r.ok() ? *r.config : RuntimeConfig{};
 }

@@ -494,3 +494,94 @@ TEST(HalRecordingLoader, AHoleEndsItsStreamOnly) {
 
 }  // namespace
 }  // namespace rtfuse::transport
+
+// --- files the configuration names (recording_file_t) ------------------------
+
+namespace rtfuse::transport {
+namespace {
+
+RecordedFile calibration_file() {
+  return {"camera.calibration", "/etc/rtfuse/calibration/SN10000001.conf",
+          std::string("[LEFT_CAM_VGA]\nfx=350\n\0binary\xff", 36)};
+}
+
+TEST(HalRecordedFile, RoundTripsEveryByte) {
+  const RecordedFile f = calibration_file();
+  const std::vector<std::uint8_t> bytes = encode_recorded_file(f);
+  RecordedFile back;
+  std::string err;
+  ASSERT_TRUE(decode_recorded_file(bytes.data(), static_cast<int>(bytes.size()), &back, &err)) << err;
+  EXPECT_EQ(back.key, f.key);
+  EXPECT_EQ(back.path, f.path);
+  EXPECT_EQ(back.text, f.text);
+}
+
+TEST(HalRecordedFile, CorruptLengthsAreRefusedBeforeDecoding) {
+  const std::vector<std::uint8_t> good = encode_recorded_file(calibration_file());
+  std::string err;
+  RecordedFile out;
+  // The key's length field (after the 8-byte fingerprint) set to 0x80000000,
+  // 0 and one past the end; then the byte count to -1 and to 2 GiB.
+  for (const std::uint32_t len : {0x80000000u, 0u, static_cast<std::uint32_t>(good.size())}) {
+    std::vector<std::uint8_t> bad = good;
+    for (int i = 0; i < 4; ++i) bad[8 + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(len >> (24 - 8 * i));
+    EXPECT_FALSE(decode_recorded_file(bad.data(), static_cast<int>(bad.size()), &out, &err)) << len;
+    EXPECT_NE(err.find("recording_file_t"), std::string::npos) << err;
+  }
+  const std::size_t count_at = 8 + 4 + calibration_file().key.size() + 1 + 4 + calibration_file().path.size() + 1;
+  for (const std::uint32_t n : {0xffffffffu, 0x7fffffffu}) {
+    std::vector<std::uint8_t> bad = good;
+    for (int i = 0; i < 4; ++i) bad[count_at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(n >> (24 - 8 * i));
+    EXPECT_FALSE(decode_recorded_file(bad.data(), static_cast<int>(bad.size()), &out, &err)) << n;
+  }
+  EXPECT_FALSE(decode_recorded_file(good.data(), static_cast<int>(good.size()) - 1, &out, &err));
+  EXPECT_FALSE(decode_recorded_file(good.data(), 6, &out, &err));
+}
+
+TEST(HalRecordedFile, LimitsAndDuplicatesAreRefused) {
+  RecordingInfo info = make_info();
+  std::string err;
+  info.files = {calibration_file()};
+  EXPECT_TRUE(validate(info, &err)) << err;
+  info.files.push_back(calibration_file());
+  EXPECT_FALSE(validate(info, &err));
+  EXPECT_NE(err.find("two files for 'camera.calibration'"), std::string::npos) << err;
+  info.files = {calibration_file()};
+  info.files[0].text.assign(kMaxRecordedFileBytes + 1, 'x');
+  EXPECT_FALSE(validate(info, &err));
+  EXPECT_NE(err.find("bytes (at most"), std::string::npos) << err;
+  info.files[0] = calibration_file();
+  info.files[0].key.clear();
+  EXPECT_FALSE(validate(info, &err));
+}
+
+TEST(HalRecordingLoader, CarriesTheRecordedFilesIntoTheInfo) {
+  TempLog log("files");
+  const RecordingInfo info = make_info();
+  EventLogWriter w;
+  std::string err;
+  ASSERT_TRUE(w.open(log.path(), &err)) << err;
+  const auto bytes = encode_recording_info(info);
+  ASSERT_TRUE(w.write(5'000'000, std::string(kRecordingInfoChannel), bytes.data(), bytes.size(), &err));
+  const auto file = encode_recorded_file(calibration_file());
+  ASSERT_TRUE(w.write(5'000'000, std::string(kRecordedFileChannel), file.data(), file.size(), &err));
+  ASSERT_TRUE(w.write(5'000'001, std::string(kRecordedFileChannel), file.data(), file.size(), &err));
+  ASSERT_TRUE(w.close(&err)) << err;
+  HalRecording rec;
+  // The same key twice: the second is named.
+  EXPECT_FALSE(load(log.path(), &rec, &err));
+  EXPECT_NE(err.find("event 2 on channel rtfuse/rec/file"), std::string::npos) << err;
+  EXPECT_NE(err.find("two files for 'camera.calibration'"), std::string::npos) << err;
+
+  ASSERT_TRUE(w.open(log.path(), &err)) << err;
+  ASSERT_TRUE(w.write(5'000'000, std::string(kRecordingInfoChannel), bytes.data(), bytes.size(), &err));
+  ASSERT_TRUE(w.write(5'000'000, std::string(kRecordedFileChannel), file.data(), file.size(), &err));
+  ASSERT_TRUE(w.close(&err)) << err;
+  ASSERT_TRUE(load(log.path(), &rec, &err)) << err;
+  ASSERT_EQ(rec.info.files.size(), 1u);
+  EXPECT_EQ(rec.info.files[0].text, calibration_file().text);
+  EXPECT_TRUE(rec.outputs.empty()) << "a recorded file is not an output";
+}
+
+}  // namespace
+}  // namespace rtfuse::transport
