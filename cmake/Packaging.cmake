@@ -141,9 +141,14 @@ set(CPACK_DEBIAN_PACKAGE_CONTROL_EXTRA
 set(CPACK_DEBIAN_PACKAGE_CONTROL_STRICT_PERMISSION ON)
 
 # Read by cpack itself: the paths of the built programs for the Depends.
+set(_rtfuse_program_files "")
+foreach(prog IN LISTS RTFUSE_PACKAGE_PROGRAMS)
+  list(APPEND _rtfuse_program_files "$<TARGET_FILE:${prog}>")
+endforeach()
+list(JOIN _rtfuse_program_files ";" _rtfuse_program_files)
 find_program(RTFUSE_READELF NAMES ${CMAKE_READELF} readelf)
 file(GENERATE OUTPUT ${CMAKE_BINARY_DIR}/packaging/CPackProjectConfig.cmake CONTENT
-"set(RTFUSE_PACKAGE_FILES \"$<TARGET_FILE:rtfused>;$<TARGET_FILE:rtfuse-replay>;$<TARGET_FILE:rtfuse-sim>\")
+"set(RTFUSE_PACKAGE_FILES \"${_rtfuse_program_files}\")
 set(RTFUSE_READELF \"${RTFUSE_READELF}\")
 set(RTFUSE_DEB_EXTRA_DEPENDS \"${RTFUSE_DEB_EXTRA_DEPENDS}\")
 include(\"${CMAKE_SOURCE_DIR}/packaging/deb-depends.cmake\")

@@ -3,7 +3,7 @@
 #
 # Checks the rtfuse .deb without installing it: name, control fields,
 # maintainer scripts, conffiles, and that it holds exactly what it must (the
-# three programs for ARCH, every config of SRCDIR/config, the unit, the jar,
+# four programs for ARCH, every config of SRCDIR/config, the unit, the jar,
 # the Python types and tools) and no other program (no test or bench binary).
 # Prints every problem found, then exits 1 if there was one; 0 all good;
 # 2 usage or an unreadable package.
@@ -66,10 +66,11 @@ need() {  # need PATH [TYPE-TEST]
   local p=$1 t=${2:--f}
   test "$t" "$d/$p" || bad "missing /$p"
 }
-for prog in rtfused rtfuse-replay rtfuse-sim; do need "usr/bin/$prog" -x; done
+for prog in rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot; do need "usr/bin/$prog" -x; done
 expected_etc=()
 for f in "$src"/config/*.toml; do expected_etc+=("etc/rtfuse/$(basename "$f")"); done
 for f in "$src"/config/scenarios/*.toml; do expected_etc+=("etc/rtfuse/scenarios/$(basename "$f")"); done
+for f in "$src"/config/calibration/*.conf; do expected_etc+=("etc/rtfuse/calibration/$(basename "$f")"); done
 expected_etc+=(etc/rtfuse/rtfused.toml)
 for p in "${expected_etc[@]}"; do need "$p"; done
 need lib/systemd/system/rtfused.service
@@ -86,6 +87,7 @@ same() {  # same PACKAGED SOURCE
 }
 for f in "$src"/config/*.toml; do same "etc/rtfuse/$(basename "$f")" "$f"; done
 for f in "$src"/config/scenarios/*.toml; do same "etc/rtfuse/scenarios/$(basename "$f")" "$f"; done
+for f in "$src"/config/calibration/*.conf; do same "etc/rtfuse/calibration/$(basename "$f")" "$f"; done
 same etc/rtfuse/rtfused.toml "$src/config/robot_linux.toml"
 same lib/systemd/system/rtfused.service "$src/packaging/rtfused.service"
 
@@ -98,7 +100,7 @@ else
 $(grep '^[<>]' "$tmp/conf.diff")"
 fi
 
-# --- programs: the three, for ARCH, nothing else ---------------------------
+# --- programs: the four, for ARCH, nothing else ---------------------------
 case "$arch" in
   amd64) machine="Advanced Micro Devices X86-64" ;;
   arm64) machine="AArch64" ;;
@@ -106,9 +108,9 @@ case "$arch" in
 esac
 mapfile -t elves < <(cd "$d" && find . -type f -print0 | xargs -0 -r file -N --mime-type |
   awk -F': ' '$2 ~ /application\/x-(pie-)?(executable|sharedlib|object)/ {print substr($1, 3)}' | sort)
-expected_elves=$'usr/bin/rtfuse-replay\nusr/bin/rtfuse-sim\nusr/bin/rtfused'
+expected_elves=$'usr/bin/rtfuse-camera-snapshot\nusr/bin/rtfuse-replay\nusr/bin/rtfuse-sim\nusr/bin/rtfused'
 [[ $(printf '%s\n' "${elves[@]}") == "$expected_elves" ]] ||
-  bad "ELF files are [${elves[*]}], expected exactly usr/bin/rtfuse-replay rtfuse-sim rtfused (no test or bench programs)"
+  bad "ELF files are [${elves[*]}], expected exactly usr/bin/rtfuse-camera-snapshot rtfuse-replay rtfuse-sim rtfused (no test or bench programs)"
 for e in "${elves[@]}"; do
   m=$(LC_ALL=C readelf -h "$d/$e" | awk -F': +' '/Machine:/ {print $2}')
   [[ -z $machine || $m == "$machine" ]] || bad "/$e is for '$m', not $arch ($machine)"
