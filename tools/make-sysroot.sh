@@ -39,6 +39,8 @@ packages=(
   libpng16-16 libpng-dev
   # XXH64, inlined: the header only (src/core/xxh64.hpp)
   libxxhash-dev
+  # PCG32, header-only (src/vision/stereo_egomotion.cpp)
+  libpcg-cpp-dev
 )
 
 mkdir -p "$dir"

@@ -17,6 +17,8 @@ packages=(
   libpng-dev
   # XXH64, inlined (the camera's digest of its rectified pairs, src/core/xxh64.hpp)
   libxxhash-dev
+  # PCG32, header-only: the visual odometry's deterministic RANSAC (src/vision)
+  libpcg-cpp-dev
   binutils libc6-dev
   # the aarch64 stage (tools/test-cross.sh): cross compiler, user-mode
   # emulation, and the arm64 package installed in a clean arm64 root
