@@ -1,0 +1,21 @@
+#pragma once
+// Reading an 8-bit grey image from a PNG (libpng): the KITTI frames of
+// rtfuse-vo. Any PNG libpng reads is converted to 8-bit grey. A tool's
+// reader (allocates, does file I/O); never on the real-time path.
+#include <cstdint>
+#include <string>
+#include <vector>
+
+namespace rtfuse::apps {
+
+struct GreyPng {
+  std::vector<std::uint8_t> pixels;  // width * height, rows packed
+  int width = 0;
+  int height = 0;
+};
+
+// False and *error naming the path and the cause (the errno text when it
+// cannot be opened, libpng's message when it is not a readable PNG).
+bool read_grey_png(const std::string& path, GreyPng* out, std::string* error);
+
+}  // namespace rtfuse::apps

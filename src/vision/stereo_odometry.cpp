@@ -1,0 +1,291 @@
+#include "vision/stereo_odometry.hpp"
+
+#include <algorithm>
+#include <climits>
+#include <cmath>
+
+namespace rtfuse::vision {
+
+const char* to_string(VoStatus s) noexcept {
+  switch (s) {
+    case VoStatus::kMotion: return "motion";
+    case VoStatus::kFirstFrame: return "first-frame";
+    case VoStatus::kTooFewMatches: return "too-few-matches";
+    case VoStatus::kNoConsensus: return "no-consensus";
+    case VoStatus::kBadInput: return "bad-input";
+  }
+  return "unknown";
+}
+
+struct StereoOdometry::Eye {
+  std::unique_ptr<Feature[]> features;
+  FeatureIndex index;
+  Plane<std::uint8_t> du, dv;  // full resolution, for refinement
+  Eye(int w, int h, int bin, int max_features, int match_w, int match_h)
+      : features(new Feature[static_cast<std::size_t>(std::max(1, max_features))]),
+        index(match_w, match_h, bin, max_features),
+        du(w, h),
+        dv(w, h) {}
+};
+
+struct StereoOdometry::Slot {
+  Eye left, right;
+  Slot(int w, int h, int bin, int max_features, int mw, int mh)
+      : left(w, h, bin, max_features, mw, mh), right(w, h, bin, max_features, mw, mh) {}
+};
+
+namespace {
+
+// Where the previous motion puts a previous-left feature, in matching pixels.
+class ConstantVelocity final : public MotionPrediction {
+ public:
+  ConstantVelocity(const StereoCameraModel& cam, const Eigen::Matrix4d& motion, int scale)
+      : cam_(cam), t_(motion), scale_(scale) {}
+  bool predict(int u, int v, int disparity, int* ur, int* vr, int* ul, int* vl) const noexcept override {
+    const double s = scale_;
+    const double d = std::max(1.0, s * disparity);
+    const double x = (s * u - cam_.cu) * cam_.baseline / d;
+    const double y = (s * v - cam_.cv) * cam_.baseline / d;
+    const double z = cam_.f * cam_.baseline / d;
+    const Eigen::Vector4d q = t_ * Eigen::Vector4d(x, y, z, 1.0);
+    if (q.z() < 0.1) return false;
+    const double pu = cam_.f * q.x() / q.z() + cam_.cu;
+    const double pv = cam_.f * q.y() / q.z() + cam_.cv;
+    const double pr = cam_.f * (q.x() - cam_.baseline) / q.z() + cam_.cu;
+    if (!std::isfinite(pu) || !std::isfinite(pv) || !std::isfinite(pr) || std::abs(pu) > 1e6 || std::abs(pv) > 1e6 ||
+        std::abs(pr) > 1e6) {
+      return false;
+    }
+    *ul = static_cast<int>(std::lround(pu / s));
+    *vl = static_cast<int>(std::lround(pv / s));
+    *ur = static_cast<int>(std::lround(pr / s));
+    *vr = *vl;
+    return true;
+  }
+
+ private:
+  const StereoCameraModel& cam_;
+  Eigen::Matrix4d t_;
+  int scale_;
+};
+
+// The 32-byte descriptor at full-resolution (u, v), as describe() builds it.
+void descriptor_at(const Plane<std::uint8_t>& du, const Plane<std::uint8_t>& dv, int u, int v,
+                   std::uint8_t* out) noexcept {
+  Feature f;
+  f.u = u;
+  f.v = v;
+  describe(du, dv, &f, 1);
+  std::copy(f.descriptor, f.descriptor + kDescriptorBytes, out);
+}
+
+// Minimum of a parabola through (-1, a), (0, b), (1, c): the offset from 0.
+double parabola_offset(int a, int b, int c) noexcept {
+  const int den = a - 2 * b + c;
+  if (den <= 0) return 0.0;
+  const double off = 0.5 * static_cast<double>(a - c) / static_cast<double>(den);
+  return std::max(-0.5, std::min(0.5, off));
+}
+
+}  // namespace
+
+StereoOdometry::StereoOdometry(int width, int height, const StereoCameraModel& camera,
+                               const StereoOdometryParams& params)
+    : width_(width),
+      height_(height),
+      scale_(params.half_resolution ? 2 : 1),
+      camera_(camera),
+      params_(params),
+      max_features_(max_features(width / scale_, height / scale_, params.suppression)),
+      filters_(width),
+      half_(params.half_resolution ? width / 2 : 1, params.half_resolution ? height / 2 : 1),
+      blob_(width / scale_, height / scale_),
+      corner_(width / scale_, height / scale_),
+      du_small_(width / scale_, height / scale_),
+      dv_small_(width / scale_, height / scale_),
+      matcher_(max_features_),
+      match_capacity_(max_features_),
+      egomotion_(max_features_) {
+  const int mw = width / scale_, mh = height / scale_;
+  const int bin = std::max(1, params.bin_size_px / scale_);
+  for (auto& s : slots_) s = std::make_unique<Slot>(width, height, bin, max_features_, mw, mh);
+  match_.max_disparity = params.max_disparity_px / scale_;
+  match_.row_tolerance = std::max(0, params.row_tolerance_px / scale_);
+  match_.flow_radius = params.flow_radius_px / scale_;
+  match_.predicted_radius = std::max(1, params.predicted_radius_px / scale_);
+  matches_.reset(new CircularMatch[static_cast<std::size_t>(std::max(1, match_capacity_))]);
+  bucket_cols_ = std::max(1, (width + params.bucket_size_px - 1) / params.bucket_size_px);
+  bucket_rows_ = std::max(1, (height + params.bucket_size_px - 1) / params.bucket_size_px);
+  bucket_count_.reset(new int[static_cast<std::size_t>(bucket_cols_ * bucket_rows_ * std::max(1, params.bucket_max))]);
+  observations_.reset(new StereoObservation[static_cast<std::size_t>(std::max(1, match_capacity_))]);
+}
+
+StereoOdometry::~StereoOdometry() = default;
+
+void StereoOdometry::reset() noexcept {
+  have_prev_ = false;
+  have_motion_ = false;
+}
+
+void StereoOdometry::detect(const GreyView& img, Eye& eye) noexcept {
+  // Full-resolution gradients for refinement; the matching image's for the
+  // descriptors.
+  filters_.sobel5x5(img, eye.du, eye.dv);
+  GreyView match = img;
+  if (scale_ == 2) {
+    FeatureFilters::halve(img, half_);
+    match = view_of(half_);
+    filters_.sobel5x5(match, du_small_, dv_small_);
+  }
+  filters_.blob_corner5x5(match, blob_, corner_);
+  int dropped = 0;
+  const int n = suppress_non_maxima(blob_, corner_, params_.suppression, eye.features.get(), max_features_, &dropped);
+  if (scale_ == 2) {
+    describe(du_small_, dv_small_, eye.features.get(), n);
+  } else {
+    describe(eye.du, eye.dv, eye.features.get(), n);
+  }
+  eye.index.build(eye.features.get(), n);
+}
+
+int StereoOdometry::bucket(const Slot& /*prev*/, const Slot& cur, int n) noexcept {
+  // Per bucket, the bucket_max matches whose current-left feature responds
+  // most strongly (ties: the earlier match), kept in match order.
+  const int k = std::max(1, params_.bucket_max);
+  const int buckets = bucket_cols_ * bucket_rows_;
+  std::fill(bucket_count_.get(), bucket_count_.get() + buckets * k, -1);
+  const Feature* lc = cur.left.features.get();
+  auto strength = [&](int m) { return std::abs(static_cast<int>(lc[matches_[m].lc].value)); };
+  for (int m = 0; m < n; ++m) {
+    const Feature& f = lc[matches_[m].lc];
+    const int bu = std::min(bucket_cols_ - 1, f.u * scale_ / params_.bucket_size_px);
+    const int bv = std::min(bucket_rows_ - 1, f.v * scale_ / params_.bucket_size_px);
+    int* slot = bucket_count_.get() + (bv * bucket_cols_ + bu) * k;
+    // Insert by strength, stronger first; an equal strength stays behind.
+    int pos = k;
+    for (int j = 0; j < k; ++j) {
+      if (slot[j] < 0 || strength(m) > strength(slot[j])) {
+        pos = j;
+        break;
+      }
+    }
+    if (pos == k) continue;
+    for (int j = k - 1; j > pos; --j) slot[j] = slot[j - 1];
+    slot[pos] = m;
+  }
+  // Compact the kept matches in their original order.
+  int kept = 0;
+  for (int m = 0; m < n; ++m) {
+    const Feature& f = lc[matches_[m].lc];
+    const int bu = std::min(bucket_cols_ - 1, f.u * scale_ / params_.bucket_size_px);
+    const int bv = std::min(bucket_rows_ - 1, f.v * scale_ / params_.bucket_size_px);
+    const int* slot = bucket_count_.get() + (bv * bucket_cols_ + bu) * k;
+    if (std::find(slot, slot + k, m) != slot + k) matches_[kept++] = matches_[m];
+  }
+  return kept;
+}
+
+bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMatch& m,
+                            StereoObservation* out) const noexcept {
+  const int s = scale_;
+  const Feature& lc = cur.left.features[m.lc];
+  const int ru = lc.u * s, rv = lc.v * s;
+  std::uint8_t ref[kDescriptorBytes];
+  descriptor_at(cur.left.du, cur.left.dv, ru, rv, ref);
+  const int r = params_.refine_radius_px;
+  // The position in `eye` (full resolution) whose descriptor is closest to
+  // the reference, near (u0, v0); sub-pixel by a parabola through the costs.
+  auto locate = [&](const Eye& eye, const Feature& f, double* u, double* v) {
+    const int u0 = f.u * s, v0 = f.v * s;
+    // The search window must keep the descriptor inside the image.
+    if (u0 - r < 5 + 2 || v0 - r < 5 + 2 || u0 + r >= width_ - 7 || v0 + r >= height_ - 7) {
+      *u = u0, *v = v0;
+      return true;
+    }
+    int cost[9][9];  // r <= 4
+    int best = INT_MAX, bu = 0, bv = 0;
+    std::uint8_t d[kDescriptorBytes];
+    for (int dv = -r; dv <= r; ++dv) {
+      for (int du = -r; du <= r; ++du) {
+        descriptor_at(eye.du, eye.dv, u0 + du, v0 + dv, d);
+        const int c = descriptor_sad(ref, d);
+        cost[dv + r][du + r] = c;
+        if (c < best) best = c, bu = du, bv = dv;
+      }
+    }
+    *u = u0 + bu;
+    *v = v0 + bv;
+    if (params_.subpixel) {
+      // A minimum on the window's edge is not a minimum: the match is dropped.
+      if (bu == -r || bu == r || bv == -r || bv == r) return r == 0;
+      *u += parabola_offset(cost[bv + r][bu + r - 1], best, cost[bv + r][bu + r + 1]);
+      *v += parabola_offset(cost[bv + r - 1][bu + r], best, cost[bv + r + 1][bu + r]);
+    }
+    return true;
+  };
+  double vr = 0.0;
+  out->u_lc = ru;
+  out->v_lc = rv;
+  return locate(prev.left, prev.left.features[m.lp], &out->u_lp, &out->v_lp) &&
+         locate(prev.right, prev.right.features[m.rp], &out->u_rp, &vr) &&
+         locate(cur.right, cur.right.features[m.rc], &out->u_rc, &out->v_rc);
+}
+
+StereoOdometryResult StereoOdometry::process(const GreyView& left, const GreyView& right,
+                                             std::uint64_t frame_number) noexcept {
+  StereoOdometryResult res;
+  if (!left.valid() || !right.valid() || left.width != width_ || left.height != height_ || right.width != width_ ||
+      right.height != height_) {
+    res.status = VoStatus::kBadInput;
+    return res;
+  }
+  Slot& cur = *slots_[cur_];
+  Slot& prev = *slots_[1 - cur_];
+  detect(left, cur.left);
+  detect(right, cur.right);
+  res.features_left = cur.left.index.count();
+  res.features_right = cur.right.index.count();
+  if (!have_prev_) {
+    res.status = VoStatus::kFirstFrame;
+    have_prev_ = true;
+    cur_ = 1 - cur_;
+    return res;
+  }
+  const ConstantVelocity cv(camera_, egomotion_transform(last_motion_.params), scale_);
+  res.predicted = have_motion_;
+  int n = matcher_.match(prev.left.index, prev.right.index, cur.left.index, cur.right.index, match_,
+                         have_motion_ ? &cv : nullptr, matches_.get(), match_capacity_);
+  // A prediction that found little (a sudden change of motion) is not
+  // trusted: the full search again.
+  if (have_motion_ && n < 3 * params_.egomotion.min_inliers) {
+    res.predicted = false;
+    n = matcher_.match(prev.left.index, prev.right.index, cur.left.index, cur.right.index, match_, nullptr,
+                       matches_.get(), match_capacity_);
+  }
+  res.matches = n;
+  n = bucket(prev, cur, n);
+  int obs = 0;
+  for (int i = 0; i < n; ++i) {
+    if (refine(prev, cur, matches_[i], &observations_[obs])) ++obs;
+  }
+  res.bucketed = obs;
+  cur_ = 1 - cur_;
+  if (obs < params_.egomotion.min_inliers) {
+    res.status = VoStatus::kTooFewMatches;
+    have_motion_ = false;
+    return res;
+  }
+  const std::uint64_t seed = params_.seed ^ (frame_number * 0x9E3779B97F4A7C15ULL);
+  res.motion = egomotion_.estimate(camera_, observations_.get(), obs, params_.egomotion, seed);
+  if (!res.motion.ok) {
+    res.status = VoStatus::kNoConsensus;
+    have_motion_ = false;
+    return res;
+  }
+  res.status = VoStatus::kMotion;
+  last_motion_ = res.motion;
+  have_motion_ = true;
+  return res;
+}
+
+}  // namespace rtfuse::vision
