@@ -71,7 +71,7 @@ int main(int argc, char** argv) {
   Eigen::Matrix4d pose = Eigen::Matrix4d::Identity();
   Eigen::Matrix4d last_step = Eigen::Matrix4d::Identity();  // camera k -> camera k-1
   std::vector<double> ms;
-  std::int64_t failed = 0, unreadable = 0, inliers = 0, solved = 0;
+  std::int64_t failed = 0, unreadable = 0, inliers = 0, solved = 0, features = 0, matches = 0, processed = 0;
   rtfuse::apps::GreyPng left, right;
   for (std::size_t k = 0; k < frames; ++k) {
     bool have = true;
@@ -97,6 +97,9 @@ int main(int argc, char** argv) {
       const rtfuse::vision::StereoOdometryResult r = vo.process(lv, rv, k);
       const auto t1 = std::chrono::steady_clock::now();
       ms.push_back(std::chrono::duration<double, std::milli>(t1 - t0).count());
+      ++processed;
+      features += r.features_left;
+      matches += r.matches;
       if (r.status == rtfuse::vision::VoStatus::kMotion) {
         last_step = rtfuse::vision::egomotion_transform(r.motion.params).inverse();
         inliers += r.motion.inliers;
@@ -130,8 +133,11 @@ int main(int argc, char** argv) {
     return 1;
   }
   std::printf("{\"frames\": %zu, \"solved\": %" PRId64 ", \"failed\": %" PRId64 ", \"unreadable\": %" PRId64
-              ", \"inliers_mean\": %.1f, \"ms_per_frame_median\": %.3f, \"ms_per_frame_p99\": %.3f",
-              frames, solved, failed, unreadable, solved > 0 ? static_cast<double>(inliers) / solved : 0.0,
+              ", \"features_mean\": %.1f, \"matches_mean\": %.1f, \"inliers_mean\": %.1f, \"ms_per_frame_median\": %.3f, "
+              "\"ms_per_frame_p99\": %.3f",
+              frames, solved, failed, unreadable, processed > 0 ? static_cast<double>(features) / processed : 0.0,
+              processed > 0 ? static_cast<double>(matches) / processed : 0.0,
+              solved > 0 ? static_cast<double>(inliers) / solved : 0.0,
               percentile(ms, 0.5), percentile(ms, 0.99));
   if (!seq.ground_truth.empty()) {
     const rtfuse::apps::TrajectoryErrors e = rtfuse::apps::compare_trajectories(poses, seq.ground_truth);

@@ -8,6 +8,12 @@
 // bright blob, and the two corner polarities.
 #include <cstdint>
 
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#elif defined(__ARM_NEON)
+#include <arm_neon.h>
+#endif
+
 #include "vision/plane.hpp"
 
 namespace rtfuse::vision {
@@ -47,11 +53,33 @@ int max_features(int width, int height, const SuppressionParams& params) noexcep
 // least kMinFeatureMargin from the border).
 void describe(const Plane<std::uint8_t>& du, const Plane<std::uint8_t>& dv, Feature* features, int count) noexcept;
 
-// Sum of absolute differences of two descriptors: the matching cost.
-inline int descriptor_sad(const std::uint8_t* a, const std::uint8_t* b) noexcept {
+// The matching cost written out, for any architecture (and to check the
+// vector versions against).
+inline int descriptor_sad_plain(const std::uint8_t* a, const std::uint8_t* b) noexcept {
   int sum = 0;
   for (int i = 0; i < kDescriptorBytes; ++i) sum += a[i] > b[i] ? a[i] - b[i] : b[i] - a[i];
   return sum;
+}
+
+// Sum of absolute differences of two descriptors: the matching cost. An
+// integer sum, so the SSE2 (psadbw), NEON (vabd + pairwise adds) and plain
+// versions give the same number.
+inline int descriptor_sad(const std::uint8_t* a, const std::uint8_t* b) noexcept {
+#if defined(__SSE2__)
+  const __m128i a0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a));
+  const __m128i a1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(a + 16));
+  const __m128i b0 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b));
+  const __m128i b1 = _mm_loadu_si128(reinterpret_cast<const __m128i*>(b + 16));
+  const __m128i s = _mm_add_epi64(_mm_sad_epu8(a0, b0), _mm_sad_epu8(a1, b1));
+  return _mm_cvtsi128_si32(s) + _mm_cvtsi128_si32(_mm_srli_si128(s, 8));
+#elif defined(__ARM_NEON)
+  const uint8x16_t d0 = vabdq_u8(vld1q_u8(a), vld1q_u8(b));
+  const uint8x16_t d1 = vabdq_u8(vld1q_u8(a + 16), vld1q_u8(b + 16));
+  const uint16x8_t s = vaddq_u16(vpaddlq_u8(d0), vpaddlq_u8(d1));
+  return static_cast<int>(vaddvq_u16(s));
+#else
+  return descriptor_sad_plain(a, b);
+#endif
 }
 
 }  // namespace rtfuse::vision

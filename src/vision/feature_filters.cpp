@@ -6,13 +6,10 @@
 namespace rtfuse::vision {
 namespace {
 
-// (g >> 7) + 128 for |g| <= 12240: an arithmetic shift (floor), written as a
-// division that rounds towards minus infinity so it does not depend on how
-// the compiler shifts negative numbers.
-inline std::uint8_t gradient_byte(std::int32_t g) noexcept {
-  const std::int32_t q = g >= 0 ? g / 128 : -((-g + 127) / 128);
-  return static_cast<std::uint8_t>(q + 128);
-}
+// (g >> 7) + 128 for |g| <= 12240, the shift rounding towards minus
+// infinity: what GCC and Clang do for a negative int (and C++20 requires).
+static_assert((-1 >> 1) == -1, "the gradient bytes need an arithmetic right shift");
+inline std::uint8_t gradient_byte(int g) noexcept { return static_cast<std::uint8_t>((g >> 7) + 128); }
 
 template <class T>
 void fill_border(Plane<T>& p, int width, int height, T value) noexcept {
@@ -31,11 +28,11 @@ void fill_border(Plane<T>& p, int width, int height, T value) noexcept {
 
 FeatureFilters::FeatureFilters(int max_width)
     : max_width_(max_width),
-      smooth_(new std::int32_t[static_cast<std::size_t>(max_width)]()),
-      diff_(new std::int32_t[static_cast<std::size_t>(max_width)]()),
-      box3_(new std::int32_t[static_cast<std::size_t>(max_width)]()),
-      box5_(new std::int32_t[static_cast<std::size_t>(max_width)]()),
-      corner_(new std::int32_t[static_cast<std::size_t>(max_width)]()) {}
+      smooth_(new std::int16_t[static_cast<std::size_t>(max_width)]()),
+      diff_(new std::int16_t[static_cast<std::size_t>(max_width)]()),
+      box3_(new std::int16_t[static_cast<std::size_t>(max_width)]()),
+      box5_(new std::int16_t[static_cast<std::size_t>(max_width)]()),
+      corner_(new std::int16_t[static_cast<std::size_t>(max_width)]()) {}
 
 void FeatureFilters::halve(const GreyView& src, Plane<std::uint8_t>& dst) noexcept {
   const int w = src.width / 2, h = src.height / 2;
@@ -55,8 +52,8 @@ void FeatureFilters::sobel5x5(const GreyView& src, Plane<std::uint8_t>& du, Plan
   fill_border(du, w, h, std::uint8_t{128});
   fill_border(dv, w, h, std::uint8_t{128});
   if (w < 5 || h < 5) return;
-  std::int32_t* s = smooth_.get();
-  std::int32_t* d = diff_.get();
+  std::int16_t* s = smooth_.get();
+  std::int16_t* d = diff_.get();
   for (int v = 2; v < h - 2; ++v) {
     const std::uint8_t* r0 = src.row(v - 2);
     const std::uint8_t* r1 = src.row(v - 1);
@@ -65,8 +62,8 @@ void FeatureFilters::sobel5x5(const GreyView& src, Plane<std::uint8_t>& du, Plan
     const std::uint8_t* r4 = src.row(v + 2);
     // Vertically: [1 4 6 4 1] for du, [-1 -2 0 2 1] for dv.
     for (int u = 0; u < w; ++u) {
-      s[u] = r0[u] + 4 * r1[u] + 6 * r2[u] + 4 * r3[u] + r4[u];
-      d[u] = -r0[u] - 2 * r1[u] + 2 * r3[u] + r4[u];
+      s[u] = static_cast<std::int16_t>(r0[u] + 4 * r1[u] + 6 * r2[u] + 4 * r3[u] + r4[u]);
+      d[u] = static_cast<std::int16_t>(-r0[u] - 2 * r1[u] + 2 * r3[u] + r4[u]);
     }
     std::uint8_t* ou = du.row(v);
     std::uint8_t* ov = dv.row(v);
@@ -84,9 +81,9 @@ void FeatureFilters::blob_corner5x5(const GreyView& src, Plane<std::int16_t>& bl
   fill_border(blob, w, h, std::int16_t{0});
   fill_border(corner, w, h, std::int16_t{0});
   if (w < 5 || h < 5) return;
-  std::int32_t* b3 = box3_.get();
-  std::int32_t* b5 = box5_.get();
-  std::int32_t* c = corner_.get();
+  std::int16_t* b3 = box3_.get();
+  std::int16_t* b5 = box5_.get();
+  std::int16_t* c = corner_.get();
   for (int v = 2; v < h - 2; ++v) {
     const std::uint8_t* r0 = src.row(v - 2);
     const std::uint8_t* r1 = src.row(v - 1);
@@ -94,16 +91,16 @@ void FeatureFilters::blob_corner5x5(const GreyView& src, Plane<std::int16_t>& bl
     const std::uint8_t* r3 = src.row(v + 1);
     const std::uint8_t* r4 = src.row(v + 2);
     for (int u = 0; u < w; ++u) {
-      b3[u] = r1[u] + r2[u] + r3[u];
-      b5[u] = b3[u] + r0[u] + r4[u];
-      c[u] = -r0[u] - r1[u] + r3[u] + r4[u];  // rows [-1 -1 0 1 1]
+      b3[u] = static_cast<std::int16_t>(r1[u] + r2[u] + r3[u]);
+      b5[u] = static_cast<std::int16_t>(b3[u] + r0[u] + r4[u]);
+      c[u] = static_cast<std::int16_t>(-r0[u] - r1[u] + r3[u] + r4[u]);  // rows [-1 -1 0 1 1]
     }
     const std::uint8_t* centre = r2;
     std::int16_t* ob = blob.row(v);
     std::int16_t* oc = corner.row(v);
     for (int u = 2; u < w - 2; ++u) {
-      const std::int32_t box3 = b3[u - 1] + b3[u] + b3[u + 1];
-      const std::int32_t box5 = b5[u - 2] + b5[u - 1] + b5[u] + b5[u + 1] + b5[u + 2];
+      const int box3 = b3[u - 1] + b3[u] + b3[u + 1];
+      const int box5 = b5[u - 2] + b5[u - 1] + b5[u] + b5[u + 1] + b5[u + 2];
       ob[u] = static_cast<std::int16_t>(2 * box3 - box5 + 7 * centre[u]);
       oc[u] = static_cast<std::int16_t>(c[u - 2] + c[u - 1] - c[u + 1] - c[u + 2]);  // columns [1 1 0 -1 -1]
     }

@@ -4,29 +4,53 @@
 
 namespace rtfuse::vision {
 
-FeatureIndex::FeatureIndex(int width, int height, int bin_size, int max_features)
-    : bin_size_(bin_size),
-      cols_(std::max(1, (width + bin_size - 1) / bin_size)),
-      rows_(std::max(1, (height + bin_size - 1) / bin_size)),
+FeatureIndex::FeatureIndex(int /*width*/, int height, int max_features)
+    : height_(std::max(1, height)),
       capacity_(max_features),
-      start_(new int[static_cast<std::size_t>(kFeatureClasses * cols_ * rows_ + 1)]()),
-      order_(new int[static_cast<std::size_t>(std::max(1, max_features))]()) {}
+      start_(new int[static_cast<std::size_t>(kFeatureClasses * height_ + 1)]()),
+      order_(new int[static_cast<std::size_t>(std::max(1, max_features))]()),
+      u_(new int[static_cast<std::size_t>(std::max(1, max_features))]()) {}
 
 void FeatureIndex::build(const Feature* features, int count) noexcept {
   features_ = features;
-  count_ = std::min(count, capacity_);
-  const int bins = kFeatureClasses * cols_ * rows_;
-  std::fill(start_.get(), start_.get() + bins + 1, 0);
-  auto bin_of = [this](const Feature& f) {
-    return (f.cls * rows_ + clamp_bin(f.v, rows_)) * cols_ + clamp_bin(f.u, cols_);
-  };
-  for (int i = 0; i < count_; ++i) ++start_[bin_of(features[i]) + 1];
-  for (int b = 0; b < bins; ++b) start_[b + 1] += start_[b];
-  // A stable counting sort: start_[b] walks forward while filling, and is
-  // put back afterwards.
-  for (int i = 0; i < count_; ++i) order_[start_[bin_of(features[i])]++] = i;
-  for (int b = bins; b > 0; --b) start_[b] = start_[b - 1];
+  count_ = 0;
+  const int rows = kFeatureClasses * height_;
+  std::fill(start_.get(), start_.get() + rows + 1, 0);
+  auto row_of = [this](const Feature& f) { return f.cls * height_ + f.v; };
+  auto usable = [this](const Feature& f) { return f.cls < kFeatureClasses && f.v >= 0 && f.v < height_; };
+  for (int i = 0; i < count && count_ < capacity_; ++i) {
+    if (!usable(features[i])) continue;
+    ++start_[row_of(features[i]) + 1];
+    ++count_;
+  }
+  for (int r = 0; r < rows; ++r) start_[r + 1] += start_[r];
+  // A stable counting sort by row: start_[r] walks forward while filling
+  // and is put back afterwards.
+  int placed = 0;
+  for (int i = 0; i < count && placed < count_; ++i) {
+    if (!usable(features[i])) continue;
+    const int k = start_[row_of(features[i])]++;
+    order_[k] = i;
+    u_[k] = features[i].u;
+    ++placed;
+  }
+  for (int r = rows; r > 0; --r) start_[r] = start_[r - 1];
   start_[0] = 0;
+  // Columns in order within each row (insertion sort: rows are short and
+  // usually sorted already; stable, so equal columns keep their order).
+  for (int r = 0; r < rows; ++r) {
+    for (int k = start_[r] + 1; k < start_[r + 1]; ++k) {
+      const int o = order_[k], u = u_[k];
+      int j = k - 1;
+      while (j >= start_[r] && u_[j] > u) {
+        order_[j + 1] = order_[j];
+        u_[j + 1] = u_[j];
+        --j;
+      }
+      order_[j + 1] = o;
+      u_[j + 1] = u;
+    }
+  }
 }
 
 }  // namespace rtfuse::vision

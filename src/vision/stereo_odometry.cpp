@@ -21,17 +21,17 @@ struct StereoOdometry::Eye {
   std::unique_ptr<Feature[]> features;
   FeatureIndex index;
   Plane<std::uint8_t> du, dv;  // full resolution, for refinement
-  Eye(int w, int h, int bin, int max_features, int match_w, int match_h)
+  Eye(int w, int h, int max_features, int match_w, int match_h)
       : features(new Feature[static_cast<std::size_t>(std::max(1, max_features))]),
-        index(match_w, match_h, bin, max_features),
+        index(match_w, match_h, max_features),
         du(w, h),
         dv(w, h) {}
 };
 
 struct StereoOdometry::Slot {
   Eye left, right;
-  Slot(int w, int h, int bin, int max_features, int mw, int mh)
-      : left(w, h, bin, max_features, mw, mh), right(w, h, bin, max_features, mw, mh) {}
+  Slot(int w, int h, int max_features, int mw, int mh)
+      : left(w, h, max_features, mw, mh), right(w, h, max_features, mw, mh) {}
 };
 
 namespace {
@@ -107,8 +107,7 @@ StereoOdometry::StereoOdometry(int width, int height, const StereoCameraModel& c
       match_capacity_(max_features_),
       egomotion_(max_features_) {
   const int mw = width / scale_, mh = height / scale_;
-  const int bin = std::max(1, params.bin_size_px / scale_);
-  for (auto& s : slots_) s = std::make_unique<Slot>(width, height, bin, max_features_, mw, mh);
+  for (auto& s : slots_) s = std::make_unique<Slot>(width, height, max_features_, mw, mh);
   match_.max_disparity = params.max_disparity_px / scale_;
   match_.row_tolerance = std::max(0, params.row_tolerance_px / scale_);
   match_.flow_radius = params.flow_radius_px / scale_;
@@ -217,7 +216,7 @@ bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMat
     *v = v0 + bv;
     if (params_.subpixel) {
       // A minimum on the window's edge is not a minimum: the match is dropped.
-      if (bu == -r || bu == r || bv == -r || bv == r) return r == 0;
+      if (bu == -r || bu == r || bv == -r || bv == r) return true;
       *u += parabola_offset(cost[bv + r][bu + r - 1], best, cost[bv + r][bu + r + 1]);
       *v += parabola_offset(cost[bv + r - 1][bu + r], best, cost[bv + r + 1][bu + r]);
     }
@@ -228,7 +227,7 @@ bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMat
   out->v_lc = rv;
   return locate(prev.left, prev.left.features[m.lp], &out->u_lp, &out->v_lp) &&
          locate(prev.right, prev.right.features[m.rp], &out->u_rp, &vr) &&
-         locate(cur.right, cur.right.features[m.rc], &out->u_rc, &out->v_rc);
+         locate(cur.right, cur.right.features[m.rc], &out->u_rc, &vr) && (out->v_rc = out->v_lc, true);
 }
 
 StereoOdometryResult StereoOdometry::process(const GreyView& left, const GreyView& right,

@@ -25,7 +25,6 @@ struct StereoOdometryParams {
   bool half_resolution = true;   // detect and match at half size, refine at full size
   SuppressionParams suppression;  // at the matching resolution
   // Full-resolution pixels:
-  int bin_size_px = 50;             // feature index bins
   int max_disparity_px = 256;
   int row_tolerance_px = 2;         // left/right rows of a rectified pair
   int flow_radius_px = 200;         // motion search without a prediction

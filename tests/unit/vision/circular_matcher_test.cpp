@@ -38,7 +38,7 @@ struct Texture {
 struct Image {
   std::vector<Feature> features;
   FeatureIndex index;
-  explicit Image(const Plane<std::uint8_t>& img) : index(kW, kH, 25, max_features(kW, kH, SuppressionParams{})) {
+  explicit Image(const Plane<std::uint8_t>& img) : index(kW, kH, max_features(kW, kH, SuppressionParams{})) {
     FeatureFilters f(kW);
     Plane<std::uint8_t> du(kW, kH), dv(kW, kH);
     Plane<std::int16_t> blob(kW, kH), corner(kW, kH);
