@@ -24,6 +24,16 @@ void fill_border(Plane<T>& p, int width, int height, T value) noexcept {
   }
 }
 
+// Calls row(v, r0..r4) for every row v with a whole 5 x 5 window (r0 two
+// rows above v, r4 two below); nothing for an image narrower or lower than 5.
+template <class Row>
+void for_each_window_row(const GreyView& src, int w, Row&& row) noexcept {
+  if (w < 5 || src.height < 5) return;
+  for (int v = 2; v < src.height - 2; ++v) {
+    row(v, src.row(v - 2), src.row(v - 1), src.row(v), src.row(v + 1), src.row(v + 2));
+  }
+}
+
 }  // namespace
 
 FeatureFilters::FeatureFilters(int max_width)
@@ -51,15 +61,10 @@ void FeatureFilters::sobel5x5(const GreyView& src, Plane<std::uint8_t>& du, Plan
   const int w = std::min(src.width, max_width_), h = src.height;
   fill_border(du, w, h, std::uint8_t{128});
   fill_border(dv, w, h, std::uint8_t{128});
-  if (w < 5 || h < 5) return;
   std::int16_t* s = smooth_.get();
   std::int16_t* d = diff_.get();
-  for (int v = 2; v < h - 2; ++v) {
-    const std::uint8_t* r0 = src.row(v - 2);
-    const std::uint8_t* r1 = src.row(v - 1);
-    const std::uint8_t* r2 = src.row(v);
-    const std::uint8_t* r3 = src.row(v + 1);
-    const std::uint8_t* r4 = src.row(v + 2);
+  for_each_window_row(src, w, [&](int v, const std::uint8_t* r0, const std::uint8_t* r1, const std::uint8_t* r2,
+                                  const std::uint8_t* r3, const std::uint8_t* r4) {
     // Vertically: [1 4 6 4 1] for du, [-1 -2 0 2 1] for dv.
     for (int u = 0; u < w; ++u) {
       s[u] = static_cast<std::int16_t>(r0[u] + 4 * r1[u] + 6 * r2[u] + 4 * r3[u] + r4[u]);
@@ -72,7 +77,7 @@ void FeatureFilters::sobel5x5(const GreyView& src, Plane<std::uint8_t>& du, Plan
       ou[u] = gradient_byte(-s[u - 2] - 2 * s[u - 1] + 2 * s[u + 1] + s[u + 2]);
       ov[u] = gradient_byte(d[u - 2] + 4 * d[u - 1] + 6 * d[u] + 4 * d[u + 1] + d[u + 2]);
     }
-  }
+  });
 }
 
 void FeatureFilters::blob_corner5x5(const GreyView& src, Plane<std::int16_t>& blob,
@@ -80,16 +85,11 @@ void FeatureFilters::blob_corner5x5(const GreyView& src, Plane<std::int16_t>& bl
   const int w = std::min(src.width, max_width_), h = src.height;
   fill_border(blob, w, h, std::int16_t{0});
   fill_border(corner, w, h, std::int16_t{0});
-  if (w < 5 || h < 5) return;
   std::int16_t* b3 = box3_.get();
   std::int16_t* b5 = box5_.get();
   std::int16_t* c = corner_.get();
-  for (int v = 2; v < h - 2; ++v) {
-    const std::uint8_t* r0 = src.row(v - 2);
-    const std::uint8_t* r1 = src.row(v - 1);
-    const std::uint8_t* r2 = src.row(v);
-    const std::uint8_t* r3 = src.row(v + 1);
-    const std::uint8_t* r4 = src.row(v + 2);
+  for_each_window_row(src, w, [&](int v, const std::uint8_t* r0, const std::uint8_t* r1, const std::uint8_t* r2,
+                                  const std::uint8_t* r3, const std::uint8_t* r4) {
     for (int u = 0; u < w; ++u) {
       b3[u] = static_cast<std::int16_t>(r1[u] + r2[u] + r3[u]);
       b5[u] = static_cast<std::int16_t>(b3[u] + r0[u] + r4[u]);
@@ -104,7 +104,7 @@ void FeatureFilters::blob_corner5x5(const GreyView& src, Plane<std::int16_t>& bl
       ob[u] = static_cast<std::int16_t>(2 * box3 - box5 + 7 * centre[u]);
       oc[u] = static_cast<std::int16_t>(c[u - 2] + c[u - 1] - c[u + 1] - c[u + 2]);  // columns [1 1 0 -1 -1]
     }
-  }
+  });
 }
 
 }  // namespace rtfuse::vision

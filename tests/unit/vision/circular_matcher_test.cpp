@@ -92,6 +92,19 @@ int count_exact(const Scene& s, const std::vector<CircularMatch>& m, int fu, int
 // Nearly every closed circle is the true one. The rest are features whose
 // partner left the image, closed by a wrong partner that happens to be each
 // other's best (the egomotion's RANSAC rejects those).
+// Matches the scene with a 40 px disparity range and a 30 px motion window.
+std::vector<CircularMatch> match(const Scene& s, const MotionPrediction* predict, int predicted_radius = 10) {
+  CircularMatcher matcher(static_cast<int>(s.lc.features.size()));
+  std::vector<CircularMatch> out(2000);
+  MatchParams p;
+  p.max_disparity = 40;
+  p.flow_radius = 30;
+  p.predicted_radius = predicted_radius;
+  const int n = matcher.match(s.lp.index, s.rp.index, s.lc.index, s.rc.index, p, predict, out.data(), 2000);
+  out.resize(static_cast<std::size_t>(n));
+  return out;
+}
+
 void check(const Scene& s, const std::vector<CircularMatch>& m, int fu, int fv) {
   ASSERT_GT(m.size(), 50u);
   const int exact = count_exact(s, m, fu, fv);
@@ -102,14 +115,7 @@ TEST(CircularMatcher, RecoversDisparityAndMotionOfEveryClosedCircle) {
   const Texture t(1);
   for (const auto& [fu, fv] : {std::pair{0, 0}, std::pair{7, -3}, std::pair{-20, 5}}) {
     const Scene s(t, fu, fv);
-    CircularMatcher matcher(static_cast<int>(s.lc.features.size()));
-    std::vector<CircularMatch> out(2000);
-    MatchParams p;
-    p.max_disparity = 40;
-    p.flow_radius = 30;
-    const int n = matcher.match(s.lp.index, s.rp.index, s.lc.index, s.rc.index, p, nullptr, out.data(), 2000);
-    out.resize(static_cast<std::size_t>(n));
-    check(s, out, fu, fv);
+    check(s, match(s, nullptr), fu, fv);
   }
 }
 
@@ -117,20 +123,11 @@ TEST(CircularMatcher, APredictionNarrowsTheSearchToTheSameAnswer) {
   const Texture t(2);
   const int fu = 45, fv = -12;  // beyond a 30 px window: only the prediction finds it
   const Scene s(t, fu, fv);
-  CircularMatcher matcher(static_cast<int>(s.lc.features.size()));
-  std::vector<CircularMatch> out(2000);
-  MatchParams p;
-  p.max_disparity = 40;
-  p.flow_radius = 30;
-  p.predicted_radius = 4;
   const ExactShift predict(fu, fv);
-  const int n = matcher.match(s.lp.index, s.rp.index, s.lc.index, s.rc.index, p, &predict, out.data(), 2000);
-  out.resize(static_cast<std::size_t>(n));
-  check(s, out, fu, fv);
-  out.resize(2000);
-  const int without = matcher.match(s.lp.index, s.rp.index, s.lc.index, s.rc.index, p, nullptr, out.data(), 2000);
-  out.resize(static_cast<std::size_t>(without));
-  EXPECT_LT(count_exact(s, out, fu, fv), n / 20) << "a 30 px window cannot reach a 47 px motion";
+  const std::vector<CircularMatch> with = match(s, &predict, 4);
+  check(s, with, fu, fv);
+  EXPECT_LT(count_exact(s, match(s, nullptr), fu, fv), static_cast<int>(with.size()) / 20)
+      << "a 30 px window cannot reach a 47 px motion";
 }
 
 TEST(CircularMatcher, EachCurrentFeatureClosesOneCircleAndCapacityHolds) {

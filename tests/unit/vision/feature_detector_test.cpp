@@ -36,6 +36,14 @@ Plane<std::uint8_t> flat(int w, int h, std::uint8_t grey) {
   return img;
 }
 
+Plane<std::uint8_t> random_plane(int w, int h, std::uint32_t seed) {
+  Plane<std::uint8_t> img(w, h);
+  std::mt19937 rng(seed);
+  for (int v = 0; v < h; ++v)
+    for (int u = 0; u < w; ++u) img.row(v)[u] = static_cast<std::uint8_t>(rng() % 256);
+  return img;
+}
+
 std::vector<Feature> detect(const Responses& r, const SuppressionParams& p) {
   std::vector<Feature> out(static_cast<std::size_t>(max_features(r.blob.width(), r.blob.height(), p)));
   int dropped = -1;
@@ -85,10 +93,7 @@ TEST(FeatureDetector, ACheckerCornerIsACornerFeature) {
 // outside the block (within the margin).
 TEST(FeatureDetector, EqualsTheDefinitionOnRandomTexture) {
   const int w = 97, h = 71;
-  Plane<std::uint8_t> img(w, h);
-  std::mt19937 rng(3);
-  for (int v = 0; v < h; ++v)
-    for (int u = 0; u < w; ++u) img.row(v)[u] = static_cast<std::uint8_t>(rng() % 256);
+  Plane<std::uint8_t> img = random_plane(w, h, 3);
   const Responses r(img);
   for (const SuppressionParams& p : {SuppressionParams{3, 50, 9}, SuppressionParams{9, 200, 9}, SuppressionParams{2, 0, 8}}) {
     std::set<std::tuple<int, int, int>> expected;
@@ -125,10 +130,7 @@ TEST(FeatureDetector, EqualsTheDefinitionOnRandomTexture) {
 
 TEST(FeatureDetector, ACapacityTooSmallCountsWhatItDrops) {
   const int w = 97, h = 71;
-  Plane<std::uint8_t> img(w, h);
-  std::mt19937 rng(5);
-  for (int v = 0; v < h; ++v)
-    for (int u = 0; u < w; ++u) img.row(v)[u] = static_cast<std::uint8_t>(rng() % 256);
+  Plane<std::uint8_t> img = random_plane(w, h, 5);
   const Responses r(img);
   const std::vector<Feature> all = detect(r, SuppressionParams{});
   std::vector<Feature> some(10);
@@ -141,10 +143,7 @@ TEST(FeatureDetector, ACapacityTooSmallCountsWhatItDrops) {
 
 TEST(FeatureDetector, DescriptorsHoldTheGradientsAtTheSamplePoints) {
   const int w = 64, h = 48;
-  Plane<std::uint8_t> img(w, h);
-  std::mt19937 rng(11);
-  for (int v = 0; v < h; ++v)
-    for (int u = 0; u < w; ++u) img.row(v)[u] = static_cast<std::uint8_t>(rng() % 256);
+  Plane<std::uint8_t> img = random_plane(w, h, 11);
   const Responses r(img);
   Feature f[2];
   f[0].u = 20, f[0].v = 20;
