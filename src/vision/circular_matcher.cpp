@@ -27,10 +27,12 @@ CircularMatcher::CircularMatcher(int max_features)
 
 int CircularMatcher::match(const FeatureIndex& lp, const FeatureIndex& rp, const FeatureIndex& lc,
                            const FeatureIndex& rc, const MatchParams& p, const MotionPrediction* prediction,
-                           CircularMatch* out, int capacity) noexcept {
-  std::fill(used_.get(), used_.get() + std::min(lc.count(), capacity_), std::uint8_t{0});
+                           CircularMatch* out, int capacity, const int* queries, int num_queries) noexcept {
+  std::fill(used_.get(), used_.get() + std::min(lc.size(), capacity_), std::uint8_t{0});
   int n = 0;
-  for (int i = 0; i < lp.count() && n < capacity; ++i) {
+  const int total = queries != nullptr ? num_queries : lp.size();
+  for (int q = 0; q < total && n < capacity; ++q) {
+    const int i = queries != nullptr ? queries[q] : q;
     const Feature& a = lp.features()[i];
     // Previous left -> previous right: same row, the right image sees it further left.
     const int j = best_match(a, rp, a.u - p.max_disparity, a.u, a.v - p.row_tolerance, a.v + p.row_tolerance);

@@ -44,11 +44,12 @@ class CircularMatcher {
   // For images whose current-left feature arrays hold at most max_features.
   explicit CircularMatcher(int max_features);
 
-  // Matches into out[0..capacity); returns the count. A current-left
-  // feature closes at most one circle (the first, in previous-left order).
+  // Matches into out[0..capacity); returns the count. The circles start at
+  // the previous-left features queries[0..num_queries) (null: all, in
+  // order). A current-left feature closes at most one circle (the first).
   int match(const FeatureIndex& lp, const FeatureIndex& rp, const FeatureIndex& lc, const FeatureIndex& rc,
-            const MatchParams& params, const MotionPrediction* prediction, CircularMatch* out,
-            int capacity) noexcept;
+            const MatchParams& params, const MotionPrediction* prediction, CircularMatch* out, int capacity,
+            const int* queries = nullptr, int num_queries = 0) noexcept;
 
  private:
   int capacity_;

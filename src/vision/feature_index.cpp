@@ -14,6 +14,7 @@ FeatureIndex::FeatureIndex(int /*width*/, int height, int max_features)
 void FeatureIndex::build(const Feature* features, int count) noexcept {
   features_ = features;
   count_ = 0;
+  size_ = count;
   const int rows = kFeatureClasses * height_;
   std::fill(start_.get(), start_.get() + rows + 1, 0);
   auto row_of = [this](const Feature& f) { return f.cls * height_ + f.v; };

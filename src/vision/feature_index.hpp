@@ -23,7 +23,8 @@ class FeatureIndex {
   void build(const Feature* features, int count) noexcept;
 
   const Feature* features() const noexcept { return features_; }
-  int count() const noexcept { return count_; }
+  int count() const noexcept { return count_; }  // indexed (usable and within capacity)
+  int size() const noexcept { return size_; }    // given to build()
 
   // Calls visit(index) for every feature of class cls with u in [u0, u1]
   // and v in [v0, v1]: rows top to bottom, columns left to right (a fixed
@@ -53,6 +54,7 @@ class FeatureIndex {
   int height_, capacity_;
   const Feature* features_ = nullptr;
   int count_ = 0;
+  int size_ = 0;
   std::unique_ptr<int[]> start_;  // per (class, row): first position in order_; one more at the end
   std::unique_ptr<int[]> order_;  // feature indices by class, row, column
   std::unique_ptr<int[]> u_;      // their columns, for the binary search

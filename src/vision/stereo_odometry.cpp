@@ -115,7 +115,9 @@ StereoOdometry::StereoOdometry(int width, int height, const StereoCameraModel& c
   matches_.reset(new CircularMatch[static_cast<std::size_t>(std::max(1, match_capacity_))]);
   bucket_cols_ = std::max(1, (width + params.bucket_size_px - 1) / params.bucket_size_px);
   bucket_rows_ = std::max(1, (height + params.bucket_size_px - 1) / params.bucket_size_px);
-  bucket_count_.reset(new int[static_cast<std::size_t>(bucket_cols_ * bucket_rows_ * std::max(1, params.bucket_max))]);
+  const int per_bucket = std::max({1, params.bucket_max, params.queries_per_bucket});
+  bucket_slots_.reset(new int[static_cast<std::size_t>(bucket_cols_ * bucket_rows_ * per_bucket)]);
+  queries_.reset(new int[static_cast<std::size_t>(std::max(1, max_features_))]);
   observations_.reset(new StereoObservation[static_cast<std::size_t>(std::max(1, match_capacity_))]);
 }
 
@@ -147,23 +149,21 @@ void StereoOdometry::detect(const GreyView& img, Eye& eye) noexcept {
   eye.index.build(eye.features.get(), n);
 }
 
-int StereoOdometry::bucket(const Slot& /*prev*/, const Slot& cur, int n) noexcept {
-  // Per bucket, the bucket_max matches whose current-left feature responds
-  // most strongly (ties: the earlier match), kept in match order.
-  const int k = std::max(1, params_.bucket_max);
-  const int buckets = bucket_cols_ * bucket_rows_;
-  std::fill(bucket_count_.get(), bucket_count_.get() + buckets * k, -1);
-  const Feature* lc = cur.left.features.get();
-  auto strength = [&](int m) { return std::abs(static_cast<int>(lc[matches_[m].lc].value)); };
+namespace {
+
+// Of n items, the k strongest of each bucket (ties: the earlier item), as
+// positions 0..n in their original order, into kept; returns how many.
+// slots holds buckets * k ints.
+template <class BucketOf, class StrengthOf>
+int keep_strongest(int n, int buckets, int k, BucketOf bucket_of, StrengthOf strength_of, int* slots,
+                   int* kept) noexcept {
+  std::fill(slots, slots + buckets * k, -1);
   for (int m = 0; m < n; ++m) {
-    const Feature& f = lc[matches_[m].lc];
-    const int bu = std::min(bucket_cols_ - 1, f.u * scale_ / params_.bucket_size_px);
-    const int bv = std::min(bucket_rows_ - 1, f.v * scale_ / params_.bucket_size_px);
-    int* slot = bucket_count_.get() + (bv * bucket_cols_ + bu) * k;
+    int* slot = slots + bucket_of(m) * k;
     // Insert by strength, stronger first; an equal strength stays behind.
     int pos = k;
     for (int j = 0; j < k; ++j) {
-      if (slot[j] < 0 || strength(m) > strength(slot[j])) {
+      if (slot[j] < 0 || strength_of(m) > strength_of(slot[j])) {
         pos = j;
         break;
       }
@@ -172,15 +172,43 @@ int StereoOdometry::bucket(const Slot& /*prev*/, const Slot& cur, int n) noexcep
     for (int j = k - 1; j > pos; --j) slot[j] = slot[j - 1];
     slot[pos] = m;
   }
-  // Compact the kept matches in their original order.
-  int kept = 0;
+  int count = 0;
   for (int m = 0; m < n; ++m) {
-    const Feature& f = lc[matches_[m].lc];
-    const int bu = std::min(bucket_cols_ - 1, f.u * scale_ / params_.bucket_size_px);
-    const int bv = std::min(bucket_rows_ - 1, f.v * scale_ / params_.bucket_size_px);
-    const int* slot = bucket_count_.get() + (bv * bucket_cols_ + bu) * k;
-    if (std::find(slot, slot + k, m) != slot + k) matches_[kept++] = matches_[m];
+    const int* slot = slots + bucket_of(m) * k;
+    if (std::find(slot, slot + k, m) != slot + k) kept[count++] = m;
   }
+  return count;
+}
+
+}  // namespace
+
+int StereoOdometry::bucket_of(int u, int v) const noexcept {
+  const int bu = std::min(bucket_cols_ - 1, u * scale_ / params_.bucket_size_px);
+  const int bv = std::min(bucket_rows_ - 1, v * scale_ / params_.bucket_size_px);
+  return bv * bucket_cols_ + bu;
+}
+
+int StereoOdometry::select_queries(const Eye& prev_left) noexcept {
+  const Feature* f = prev_left.features.get();
+  const int n = prev_left.index.size();
+  if (params_.queries_per_bucket <= 0) {
+    for (int i = 0; i < n; ++i) queries_[i] = i;
+    return n;
+  }
+  return keep_strongest(
+      n, bucket_cols_ * bucket_rows_, params_.queries_per_bucket, [&](int i) { return bucket_of(f[i].u, f[i].v); },
+      [&](int i) { return std::abs(static_cast<int>(f[i].value)); }, bucket_slots_.get(), queries_.get());
+}
+
+int StereoOdometry::bucket(const Slot& cur, int n) noexcept {
+  // Per bucket, the bucket_max matches whose current-left feature responds
+  // most strongly, kept in match order.
+  const Feature* lc = cur.left.features.get();
+  const int kept = keep_strongest(
+      n, bucket_cols_ * bucket_rows_, std::max(1, params_.bucket_max),
+      [&](int m) { return bucket_of(lc[matches_[m].lc].u, lc[matches_[m].lc].v); },
+      [&](int m) { return std::abs(static_cast<int>(lc[matches_[m].lc].value)); }, bucket_slots_.get(), queries_.get());
+  for (int i = 0; i < kept; ++i) matches_[i] = matches_[queries_[i]];
   return kept;
 }
 
@@ -252,17 +280,18 @@ StereoOdometryResult StereoOdometry::process(const GreyView& left, const GreyVie
   }
   const ConstantVelocity cv(camera_, egomotion_transform(last_motion_.params), scale_);
   res.predicted = have_motion_;
+  const int queries = select_queries(prev.left);
   int n = matcher_.match(prev.left.index, prev.right.index, cur.left.index, cur.right.index, match_,
-                         have_motion_ ? &cv : nullptr, matches_.get(), match_capacity_);
+                         have_motion_ ? &cv : nullptr, matches_.get(), match_capacity_, queries_.get(), queries);
   // A prediction that found little (a sudden change of motion) is not
   // trusted: the full search again.
   if (have_motion_ && n < 3 * params_.egomotion.min_inliers) {
     res.predicted = false;
     n = matcher_.match(prev.left.index, prev.right.index, cur.left.index, cur.right.index, match_, nullptr,
-                       matches_.get(), match_capacity_);
+                       matches_.get(), match_capacity_, queries_.get(), queries);
   }
   res.matches = n;
-  n = bucket(prev, cur, n);
+  n = bucket(cur, n);
   int obs = 0;
   for (int i = 0; i < n; ++i) {
     if (refine(prev, cur, matches_[i], &observations_[obs])) ++obs;

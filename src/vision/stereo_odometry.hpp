@@ -31,6 +31,10 @@ struct StereoOdometryParams {
   int predicted_radius_px = 24;     // around the previous motion's prediction
   int bucket_size_px = 50;          // spread: at most bucket_max matches per bucket
   int bucket_max = 2;
+  // Circles start only at the strongest previous-left features of each
+  // bucket (0: at every feature): most circles are discarded by the
+  // buckets anyway, so this keeps the matching's cost to what is used.
+  int queries_per_bucket = 8;
   int refine_radius_px = 2;         // full-resolution search around a match
   bool subpixel = true;             // parabola through the refined costs
   EgomotionParams egomotion;
@@ -77,7 +81,9 @@ class StereoOdometry {
   struct Eye;
   struct Slot;
   void detect(const GreyView& img, Eye& eye) noexcept;
-  int bucket(const Slot& prev, const Slot& cur, int n) noexcept;
+  int bucket_of(int u, int v) const noexcept;  // matching-resolution position
+  int select_queries(const Eye& prev_left) noexcept;
+  int bucket(const Slot& cur, int n) noexcept;
   bool refine(const Slot& prev, const Slot& cur, const CircularMatch& m, StereoObservation* out) const noexcept;
 
   int width_, height_, scale_;
@@ -97,7 +103,8 @@ class StereoOdometry {
   CircularMatcher matcher_;
   std::unique_ptr<CircularMatch[]> matches_;
   int match_capacity_;
-  std::unique_ptr<int[]> bucket_count_;
+  std::unique_ptr<int[]> bucket_slots_;  // buckets x the most kept per bucket
+  std::unique_ptr<int[]> queries_;  // previous-left features that start a circle; kept matches
   int bucket_cols_, bucket_rows_;
   std::unique_ptr<StereoObservation[]> observations_;
   StereoEgomotion egomotion_;
