@@ -21,11 +21,13 @@ struct StereoOdometry::Eye {
   std::unique_ptr<Feature[]> features;
   FeatureIndex index;
   Plane<std::uint8_t> du, dv;  // full resolution, for refinement
+  Plane<std::uint8_t> grey;    // the image itself (the caller's may be gone next frame)
   Eye(int w, int h, int max_features, int match_w, int match_h)
       : features(new Feature[static_cast<std::size_t>(std::max(1, max_features))]),
         index(match_w, match_h, max_features),
         du(w, h),
-        dv(w, h) {}
+        dv(w, h),
+        grey(w, h) {}
 };
 
 struct StereoOdometry::Slot {
@@ -79,14 +81,6 @@ void descriptor_at(const Plane<std::uint8_t>& du, const Plane<std::uint8_t>& dv,
   std::copy(f.descriptor, f.descriptor + kDescriptorBytes, out);
 }
 
-// Minimum of a parabola through (-1, a), (0, b), (1, c): the offset from 0.
-double parabola_offset(int a, int b, int c) noexcept {
-  const int den = a - 2 * b + c;
-  if (den <= 0) return 0.0;
-  const double off = 0.5 * static_cast<double>(a - c) / static_cast<double>(den);
-  return std::max(-0.5, std::min(0.5, off));
-}
-
 }  // namespace
 
 StereoOdometry::StereoOdometry(int width, int height, const StereoCameraModel& camera,
@@ -129,6 +123,7 @@ void StereoOdometry::reset() noexcept {
 }
 
 void StereoOdometry::detect(const GreyView& img, Eye& eye) noexcept {
+  for (int v = 0; v < img.height; ++v) std::copy(img.row(v), img.row(v) + img.width, eye.grey.row(v));
   // Full-resolution gradients for refinement; the matching image's for the
   // descriptors.
   filters_.sobel5x5(img, eye.du, eye.dv);
@@ -213,12 +208,13 @@ int StereoOdometry::bucket(const Slot& cur, int n) noexcept {
 }
 
 bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMatch& m,
-                            StereoObservation* out) const noexcept {
+                            StereoObservation* out) noexcept {
   const int s = scale_;
   const Feature& lc = cur.left.features[m.lc];
   const int ru = lc.u * s, rv = lc.v * s;
   std::uint8_t ref[kDescriptorBytes];
   descriptor_at(cur.left.du, cur.left.dv, ru, rv, ref);
+  const bool have_patch = params_.subpixel && aligner_.set_reference(cur.left.grey, ru, rv);
   const int r = params_.refine_radius_px;
   // The position in `eye` (full resolution) whose descriptor is closest to
   // the reference, near (u0, v0); sub-pixel by a parabola through the costs.
@@ -229,24 +225,21 @@ bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMat
       *u = u0, *v = v0;
       return true;
     }
-    int cost[9][9];  // r <= 4
     int best = INT_MAX, bu = 0, bv = 0;
     std::uint8_t d[kDescriptorBytes];
     for (int dv = -r; dv <= r; ++dv) {
       for (int du = -r; du <= r; ++du) {
         descriptor_at(eye.du, eye.dv, u0 + du, v0 + dv, d);
         const int c = descriptor_sad(ref, d);
-        cost[dv + r][du + r] = c;
         if (c < best) best = c, bu = du, bv = dv;
       }
     }
     *u = u0 + bu;
     *v = v0 + bv;
-    if (params_.subpixel) {
-      // A minimum on the window's edge is not a minimum: the match is dropped.
-      if (bu == -r || bu == r || bv == -r || bv == r) return true;
-      *u += parabola_offset(cost[bv + r][bu + r - 1], best, cost[bv + r][bu + r + 1]);
-      *v += parabola_offset(cost[bv + r - 1][bu + r], best, cost[bv + r + 1][bu + r]);
+    // The fraction: the reference patch aligned in this image.
+    if (have_patch) {
+      double au = 0.0, av = 0.0;
+      if (aligner_.align(eye.grey, *u, *v, 1.5, &au, &av)) *u = au, *v = av;
     }
     return true;
   };

@@ -16,6 +16,7 @@
 #include "vision/feature_detector.hpp"
 #include "vision/feature_filters.hpp"
 #include "vision/feature_index.hpp"
+#include "vision/patch_aligner.hpp"
 #include "vision/plane.hpp"
 #include "vision/stereo_egomotion.hpp"
 
@@ -36,7 +37,7 @@ struct StereoOdometryParams {
   // buckets anyway, so this keeps the matching's cost to what is used.
   int queries_per_bucket = 8;
   int refine_radius_px = 2;         // full-resolution search around a match
-  bool subpixel = true;             // parabola through the refined costs
+  bool subpixel = true;             // align the current-left patch in the other images (vision/patch_aligner)
   EgomotionParams egomotion;
   std::uint64_t seed = 0x7274667573652d76ULL;  // mixed with the frame number for RANSAC
 };
@@ -84,7 +85,7 @@ class StereoOdometry {
   int bucket_of(int u, int v) const noexcept;  // matching-resolution position
   int select_queries(const Eye& prev_left) noexcept;
   int bucket(const Slot& cur, int n) noexcept;
-  bool refine(const Slot& prev, const Slot& cur, const CircularMatch& m, StereoObservation* out) const noexcept;
+  bool refine(const Slot& prev, const Slot& cur, const CircularMatch& m, StereoObservation* out) noexcept;
 
   int width_, height_, scale_;
   StereoCameraModel camera_;
@@ -108,6 +109,7 @@ class StereoOdometry {
   int bucket_cols_, bucket_rows_;
   std::unique_ptr<StereoObservation[]> observations_;
   StereoEgomotion egomotion_;
+  PatchAligner aligner_;
 };
 
 }  // namespace rtfuse::vision
