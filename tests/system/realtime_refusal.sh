@@ -50,14 +50,23 @@ for n in required_fifo required_lock; do
 done
 
 # Thread names and a clean stop on SIGINT.
-"$rtfused" --duration 30 --quiet --lcm-url memq:// >"$work/out_sig" 2>"$work/err_sig" &
+# Start-up (the camera's world, textures and rectification tables) takes a
+# few seconds under emulation: wait for the threads rather than a fixed time.
+"$rtfused" --duration 120 --quiet --lcm-url memq:// >"$work/out_sig" 2>"$work/err_sig" &
 pid=$!
-sleep 1.5
-names=$(cat /proc/$pid/task/*/comm | sort | tr '\n' ' ')
-echo "threads: $names"
-for n in rtfuse-loop rtfuse-pub rtfuse-lcmin rtfuse-imu rtfuse-sim; do
-  [[ " $names " == *" $n "* ]] || { echo "FAIL: no thread named $n"; kill $pid; exit 1; }
+want=(rtfuse-loop rtfuse-pub rtfuse-lcmin rtfuse-imu rtfuse-camera rtfuse-sim)
+for _ in $(seq 120); do
+  sleep 0.5
+  names=$(cat /proc/$pid/task/*/comm 2>/dev/null | sort | tr '\n' ' ')
+  missing=0
+  for n in "${want[@]}"; do [[ " $names " == *" $n "* ]] || missing=1; done
+  ((missing == 0)) && break
 done
+echo "threads: $names"
+for n in "${want[@]}"; do
+  [[ " $names " == *" $n "* ]] || { echo "FAIL: no thread named $n within 60 s"; kill $pid; exit 1; }
+done
+sleep 1  # a second of running before the stop
 kill -INT $pid
 set +e
 wait $pid
