@@ -1,6 +1,7 @@
 #include "drivers/canopen/canopen_encoders.hpp"
 
 #include <algorithm>
+#include <cmath>
 #include <cstdarg>
 #include <cstdio>
 
@@ -288,8 +289,11 @@ void CanopenEncoders::on_tpdo(Node& node, const hal::CanFrame& frame) noexcept {
     if (node.max_counts_per_s > 0.0 &&
         static_cast<double>(abs64(step)) > node.max_counts_per_s * dt_s + 1.0) {
       // Re-base on the new value so a permanent offset costs one sample.
-      set_node_error(node, "node %d: position jumped %lld counts in one SYNC, faster than %.0f counts/s; rejected",
-                     node.cfg.node_id, static_cast<long long>(step), node.max_counts_per_s);
+      // Integers only: the loop formats no floating point (glibc's %f may
+      // take a heap buffer for large values).
+      set_node_error(node, "node %d: position jumped %lld counts in one SYNC, faster than %lld counts/s; rejected",
+                     node.cfg.node_id, static_cast<long long>(step),
+                     static_cast<long long>(std::llround(node.max_counts_per_s)));
       jumped = true;
       step = 0;
       ++node.segment;
