@@ -22,12 +22,20 @@ bool is_extremum(const Plane<std::int16_t>& r, const Extremum& e, int sign, int 
                  int vmax) noexcept {
   const int u0 = std::max(0, e.u - n), u1 = std::min(umax, e.u + n);
   const int v0 = std::max(0, e.v - n), v1 = std::min(vmax, e.v + n);
+  // Row by row; on the block's rows only the parts left and right of it.
+  const int limit = sign * e.value;
+  auto beaten = [&](const std::int16_t* row, int a, int b) {
+    for (int u = a; u <= b; ++u) {
+      if (sign * row[u] > limit) return true;
+    }
+    return false;
+  };
   for (int v = v0; v <= v1; ++v) {
     const std::int16_t* row = r.row(v);
-    const bool in_block_rows = v >= bv && v <= bv + n;
-    for (int u = u0; u <= u1; ++u) {
-      if (in_block_rows && u >= bu && u <= bu + n) continue;
-      if (sign * row[u] > sign * e.value) return false;
+    if (v >= bv && v <= bv + n) {
+      if (beaten(row, u0, std::min(u1, bu - 1)) || beaten(row, std::max(u0, bu + n + 1), u1)) return false;
+    } else if (beaten(row, u0, u1)) {
+      return false;
     }
   }
   return true;
