@@ -33,7 +33,7 @@ struct Feature {
 };
 
 struct SuppressionParams {
-  int n = 3;        // block (n+1)^2, neighbourhood (2n+1)^2
+  int n = 3;        // block (n+1)^2, neighbourhood (2n+1)^2; at most 63
   int tau = 50;     // |response| at least this
   int margin = 9;   // no feature closer to the border (>= kMinFeatureMargin)
 };
@@ -43,6 +43,9 @@ struct SuppressionParams {
 // `capacity` are written; *dropped counts the ones that did not fit.
 int suppress_non_maxima(const Plane<std::int16_t>& blob, const Plane<std::int16_t>& corner,
                         const SuppressionParams& params, Feature* out, int capacity, int* dropped) noexcept;
+// The same without vector instructions: what the vector version must equal.
+int suppress_non_maxima_plain(const Plane<std::int16_t>& blob, const Plane<std::int16_t>& corner,
+                              const SuppressionParams& params, Feature* out, int capacity, int* dropped) noexcept;
 
 // Upper bound on what suppress_non_maxima can return for a width x height
 // image: four per block. Sizing the feature arrays with it means nothing is

@@ -80,6 +80,33 @@ void FeatureFilters::sobel5x5(const GreyView& src, Plane<std::uint8_t>& du, Plan
   });
 }
 
+void FeatureFilters::sobel5x5_window(const GreyView& src, int u0, int v0, Plane<std::uint8_t>& du,
+                                     Plane<std::uint8_t>& dv) noexcept {
+  // Windows are small (refinement's 15 x 15): the vertical sums of one
+  // output row live on the stack, 4 columns wider than the window.
+  constexpr int kMaxWindow = 60;
+  const int w = std::min(du.width(), kMaxWindow), h = du.height();
+  std::int16_t s[kMaxWindow + 4], d[kMaxWindow + 4];
+  for (int y = 0; y < h; ++y) {
+    const int v = v0 + y;
+    const std::uint8_t* r0 = src.row(v - 2) + u0 - 2;
+    const std::uint8_t* r1 = src.row(v - 1) + u0 - 2;
+    const std::uint8_t* r2 = src.row(v) + u0 - 2;
+    const std::uint8_t* r3 = src.row(v + 1) + u0 - 2;
+    const std::uint8_t* r4 = src.row(v + 2) + u0 - 2;
+    for (int x = 0; x < w + 4; ++x) {
+      s[x] = static_cast<std::int16_t>(r0[x] + 4 * r1[x] + 6 * r2[x] + 4 * r3[x] + r4[x]);
+      d[x] = static_cast<std::int16_t>(-r0[x] - 2 * r1[x] + 2 * r3[x] + r4[x]);
+    }
+    std::uint8_t* ou = du.row(y);
+    std::uint8_t* ov = dv.row(y);
+    for (int x = 0; x < w; ++x) {
+      ou[x] = gradient_byte(-s[x] - 2 * s[x + 1] + 2 * s[x + 3] + s[x + 4]);
+      ov[x] = gradient_byte(d[x] + 4 * d[x + 1] + 6 * d[x + 2] + 4 * d[x + 3] + d[x + 4]);
+    }
+  }
+}
+
 void FeatureFilters::blob_corner5x5(const GreyView& src, Plane<std::int16_t>& blob,
                                     Plane<std::int16_t>& corner) noexcept {
   const int w = std::min(src.width, max_width_), h = src.height;

@@ -31,6 +31,13 @@ class FeatureFilters {
   static void halve(const GreyView& src, Plane<std::uint8_t>& dst) noexcept;
   // du, dv as large as src.
   void sobel5x5(const GreyView& src, Plane<std::uint8_t>& du, Plane<std::uint8_t>& dv) noexcept;
+  // The sobel5x5 bytes of the window [u0, u0 + du.width()) x [v0, v0 +
+  // du.height()) of src, written to du, dv from their (0, 0): the same bytes
+  // as the whole image's, for the few places that need full-resolution
+  // gradients. The window must stay 2 pixels inside src and be at most 60
+  // pixels wide.
+  static void sobel5x5_window(const GreyView& src, int u0, int v0, Plane<std::uint8_t>& du,
+                              Plane<std::uint8_t>& dv) noexcept;
   // blob, corner as large as src; values within +-4080 and +-2040.
   void blob_corner5x5(const GreyView& src, Plane<std::int16_t>& blob, Plane<std::int16_t>& corner) noexcept;
 

@@ -4,12 +4,15 @@
 
 namespace rtfuse::vision {
 
-FeatureIndex::FeatureIndex(int /*width*/, int height, int max_features)
-    : height_(std::max(1, height)),
+FeatureIndex::FeatureIndex(int width, int height, int max_features)
+    : width_(std::max(1, width)),
+      height_(std::max(1, height)),
       capacity_(max_features),
+      cells_(((width_ - 1) >> kCellShift) + 1),
       start_(new int[static_cast<std::size_t>(kFeatureClasses * height_ + 1)]()),
       order_(new int[static_cast<std::size_t>(std::max(1, max_features))]()),
-      u_(new int[static_cast<std::size_t>(std::max(1, max_features))]()) {}
+      u_(new int[static_cast<std::size_t>(std::max(1, max_features))]()),
+      cell_start_(new int[static_cast<std::size_t>(kFeatureClasses * height_ * cells_)]()) {}
 
 void FeatureIndex::build(const Feature* features, int count) noexcept {
   features_ = features;
@@ -50,6 +53,12 @@ void FeatureIndex::build(const Feature* features, int count) noexcept {
       }
       order_[j + 1] = o;
       u_[j + 1] = u;
+    }
+    int* cell = cell_start_.get() + r * cells_;
+    int k = start_[r];
+    for (int c = 0; c < cells_; ++c) {
+      while (k < start_[r + 1] && cell_of(u_[k]) < c) ++k;
+      cell[c] = k;
     }
   }
 }

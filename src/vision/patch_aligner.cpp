@@ -8,15 +8,26 @@ namespace {
 constexpr int kIterations = 8;
 constexpr double kConverged = 0.01;  // px
 
-// Bilinear sample at (u, v); the caller keeps (u, v) and (u+1, v+1) inside.
-inline double sample(const Plane<std::uint8_t>& p, double u, double v) noexcept {
+// The kSize x kSize patch centred on (u, v), sampled bilinearly, into
+// out; returns its mean. Every pixel of the patch shares the fraction of
+// (u, v), so the weights are taken once (per pixel, the floor and the row
+// look-up cost more than the arithmetic). The caller keeps the patch and
+// one more column and row inside.
+inline double sample_patch(const Plane<std::uint8_t>& p, double u, double v, double* out) noexcept {
   const int iu = static_cast<int>(std::floor(u)), iv = static_cast<int>(std::floor(v));
   const double fu = u - iu, fv = v - iv;
-  const std::uint8_t* r0 = p.row(iv) + iu;
-  const std::uint8_t* r1 = p.row(iv + 1) + iu;
-  const double top = r0[0] + fu * (r0[1] - r0[0]);
-  const double bottom = r1[0] + fu * (r1[1] - r1[0]);
-  return top + fv * (bottom - top);
+  double sum = 0.0;
+  const std::uint8_t* r1 = p.row(iv - PatchAligner::kHalf) + iu - PatchAligner::kHalf;
+  for (int j = 0, k = 0; j < PatchAligner::kSize; ++j) {
+    const std::uint8_t* r0 = r1;
+    r1 = r0 + p.stride();
+    for (int i = 0; i < PatchAligner::kSize; ++i, ++k) {
+      const double top = r0[i] + fu * (r0[i + 1] - r0[i]);
+      const double bottom = r1[i] + fu * (r1[i + 1] - r1[i]);
+      sum += out[k] = top + fv * (bottom - top);
+    }
+  }
+  return sum / (PatchAligner::kSize * PatchAligner::kSize);
 }
 
 }  // namespace
@@ -59,10 +70,7 @@ bool PatchAligner::align(const Plane<std::uint8_t>& target, double u0, double v0
         cv + kHalf + 1.0 >= target.height()) {
       return false;
     }
-    double mean = 0.0;
-    for (int j = -kHalf, k = 0; j <= kHalf; ++j)
-      for (int i = -kHalf; i <= kHalf; ++i, ++k) mean += patch[k] = sample(target, cu + i, cv + j);
-    mean /= kSize * kSize;
+    const double mean = sample_patch(target, cu, cv, patch);
     double bu = 0.0, bv = 0.0;
     for (int k = 0; k < kSize * kSize; ++k) {
       const double e = (patch[k] - mean) - ref_[k];

@@ -6,6 +6,7 @@
 
 #include <cstdint>
 #include <random>
+#include <tuple>
 
 namespace rtfuse::vision {
 namespace {
@@ -82,6 +83,24 @@ TEST(FeatureFilters, ExtremeImagesStayInRange) {
       EXPECT_EQ(blob.at(u, v), convolve(img, u, v, kBlob));
       EXPECT_EQ(corner.at(u, v), convolve(img, u, v, kCorner));
     }
+  }
+}
+
+TEST(FeatureFilters, AWindowsGradientsAreTheWholeImages) {
+  const int w = 64, h = 48;
+  const Plane<std::uint8_t> img = random_image(w, h, 13);
+  FeatureFilters f(w);
+  Plane<std::uint8_t> du(w, h), dv(w, h);
+  f.sobel5x5(view_of(img), du, dv);
+  for (const auto& [u0, v0, ww, wh] : {std::tuple{2, 2, 15, 15}, std::tuple{30, 20, 11, 11}, std::tuple{2, 31, 60, 15},
+                                       std::tuple{47, 2, 15, 44}}) {
+    Plane<std::uint8_t> wu(ww, wh), wv(ww, wh);
+    FeatureFilters::sobel5x5_window(view_of(img), u0, v0, wu, wv);
+    for (int y = 0; y < wh; ++y)
+      for (int x = 0; x < ww; ++x) {
+        ASSERT_EQ(wu.at(x, y), du.at(u0 + x, v0 + y)) << u0 + x << "," << v0 + y;
+        ASSERT_EQ(wv.at(x, y), dv.at(u0 + x, v0 + y)) << u0 + x << "," << v0 + y;
+      }
   }
 }
 

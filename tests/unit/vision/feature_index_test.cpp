@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <random>
 #include <vector>
 
@@ -35,6 +36,32 @@ TEST(FeatureIndex, FindsExactlyWhatAScanFinds) {
               f[static_cast<std::size_t>(i)].v == v)
             want.push_back(i);
     ASSERT_EQ(got, want) << "window " << u0 << ".." << u1 << " x " << v0 << ".." << v1 << " class " << cls;
+  }
+}
+
+// Columns outside the image (a caller's mistake) and rows crowded into one
+// stretch of columns still come out in column order.
+TEST(FeatureIndex, ColumnsAnywhereAreFound) {
+  std::vector<Feature> f;
+  for (int u : {-40, -1, 0, 31, 32, 33, 63, 64, 70, 99, 100, 150}) {
+    Feature x;
+    x.u = u;
+    x.v = 3;
+    x.cls = 2;
+    f.push_back(x);
+  }
+  std::reverse(f.begin(), f.end());
+  FeatureIndex index(100, 10, 100);
+  index.build(f.data(), static_cast<int>(f.size()));
+  for (const auto& [u0, u1] : {std::pair{-100, 200}, std::pair{-5, 31}, std::pair{32, 64}, std::pair{65, 99},
+                               std::pair{99, 160}, std::pair{200, 300}}) {
+    std::vector<int> got, want;
+    index.for_each_in(2, u0, u1, 0, 9, [&](int i) { got.push_back(f[static_cast<std::size_t>(i)].u); });
+    for (int i = static_cast<int>(f.size()) - 1; i >= 0; --i) {
+      const int u = f[static_cast<std::size_t>(i)].u;
+      if (u >= u0 && u <= u1) want.push_back(u);
+    }
+    EXPECT_EQ(got, want) << u0 << ".." << u1;
   }
 }
 

@@ -1,0 +1,97 @@
+#pragma once
+// Eight signed 16-bit lanes for the integer image loops: SSE2 on x86-64,
+// NEON on aarch64, and a plain array everywhere. The loops take the backend
+// as a template parameter so a test can run both on the same input and
+// compare: integer lanes have one right answer, so the outputs must match
+// bit for bit on every architecture.
+#include <cstdint>
+
+#if defined(__SSE2__)
+#include <emmintrin.h>
+#elif defined(__ARM_NEON)
+#include <arm_neon.h>
+#endif
+
+namespace rtfuse::vision::simd {
+
+// The definition the vector backends must agree with.
+struct PlainI16 {
+  struct V {
+    std::int16_t x[8];
+  };
+  static V load(const std::int16_t* p) noexcept {
+    V r;
+    for (int i = 0; i < 8; ++i) r.x[i] = p[i];
+    return r;
+  }
+  static void store(std::int16_t* p, V a) noexcept {
+    for (int i = 0; i < 8; ++i) p[i] = a.x[i];
+  }
+  static V splat(int a) noexcept {
+    V r;
+    for (auto& x : r.x) x = static_cast<std::int16_t>(a);
+    return r;
+  }
+  static V max(V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = a.x[i] > b.x[i] ? a.x[i] : b.x[i];
+    return a;
+  }
+  static V min(V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = a.x[i] < b.x[i] ? a.x[i] : b.x[i];
+    return a;
+  }
+  // All ones where a > b, else zero.
+  static V gt(V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = static_cast<std::int16_t>(a.x[i] > b.x[i] ? -1 : 0);
+    return a;
+  }
+  // mask ? a : b, lane by lane (mask lanes all ones or zero).
+  static V select(V mask, V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = mask.x[i] != 0 ? a.x[i] : b.x[i];
+    return a;
+  }
+  // Bit i set where mask lane i is set.
+  static unsigned bits(V mask) noexcept {
+    unsigned r = 0;
+    for (int i = 0; i < 8; ++i) r |= mask.x[i] != 0 ? 1u << i : 0u;
+    return r;
+  }
+};
+
+#if defined(__SSE2__)
+struct NativeI16 {
+  using V = __m128i;
+  static V load(const std::int16_t* p) noexcept { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
+  static void store(std::int16_t* p, V a) noexcept { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a); }
+  static V splat(int a) noexcept { return _mm_set1_epi16(static_cast<short>(a)); }
+  static V max(V a, V b) noexcept { return _mm_max_epi16(a, b); }
+  static V min(V a, V b) noexcept { return _mm_min_epi16(a, b); }
+  static V gt(V a, V b) noexcept { return _mm_cmpgt_epi16(a, b); }
+  static V select(V mask, V a, V b) noexcept { return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b)); }
+  static unsigned bits(V mask) noexcept {
+    return static_cast<unsigned>(_mm_movemask_epi8(_mm_packs_epi16(mask, _mm_setzero_si128()))) & 0xffu;
+  }
+};
+constexpr bool kNativeIsVector = true;
+#elif defined(__ARM_NEON)
+struct NativeI16 {
+  using V = int16x8_t;
+  static V load(const std::int16_t* p) noexcept { return vld1q_s16(p); }
+  static void store(std::int16_t* p, V a) noexcept { vst1q_s16(p, a); }
+  static V splat(int a) noexcept { return vdupq_n_s16(static_cast<std::int16_t>(a)); }
+  static V max(V a, V b) noexcept { return vmaxq_s16(a, b); }
+  static V min(V a, V b) noexcept { return vminq_s16(a, b); }
+  static V gt(V a, V b) noexcept { return vreinterpretq_s16_u16(vcgtq_s16(a, b)); }
+  static V select(V mask, V a, V b) noexcept { return vbslq_s16(vreinterpretq_u16_s16(mask), a, b); }
+  static unsigned bits(V mask) noexcept {
+    static const std::uint16_t kBit[8] = {1, 2, 4, 8, 16, 32, 64, 128};
+    return vaddvq_u16(vandq_u16(vreinterpretq_u16_s16(mask), vld1q_u16(kBit)));
+  }
+};
+constexpr bool kNativeIsVector = true;
+#else
+using NativeI16 = PlainI16;
+constexpr bool kNativeIsVector = false;
+#endif
+
+}  // namespace rtfuse::vision::simd
