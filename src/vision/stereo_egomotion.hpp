@@ -34,7 +34,12 @@ struct StereoObservation {
 };
 
 struct EgomotionParams {
-  int ransac_iterations = 200;
+  int ransac_iterations = 200;  // at most
+  // Adaptive stop: enough samples for this confidence that one was all
+  // inliers, given the best set so far (0: always ransac_iterations), but
+  // never fewer than ransac_min_iterations.
+  double ransac_confidence = 0.9999;
+  int ransac_min_iterations = 30;
   double inlier_threshold_px = 2.0;  // on the root of the summed squares of the four residuals
   int min_inliers = 6;
   bool reweighting = true;  // trust points near the image's vertical centre line more (VISO2)
@@ -49,6 +54,7 @@ struct Egomotion {
   int matches = 0;
   int inliers = 0;
   double residual_rms_px = 0.0;  // over the inliers' four residuals
+  int iterations = 0;            // RANSAC samples drawn (the adaptive stop)
 };
 
 // The 4x4 transform of params: x_cur = T x_prev.

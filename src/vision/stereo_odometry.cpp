@@ -20,14 +20,15 @@ const char* to_string(VoStatus s) noexcept {
 struct StereoOdometry::Eye {
   std::unique_ptr<Feature[]> features;
   FeatureIndex index;
-  Plane<std::uint8_t> du, dv;  // full resolution, for refinement
-  Plane<std::uint8_t> grey;    // the image itself (the caller's may be gone next frame)
+  Plane<std::uint8_t> grey;  // the image itself (the caller's may be gone next frame)
+  // Per feature (left eyes): for how many frames in a row it has been an
+  // inlier of the motion, up to 255.
+  std::unique_ptr<std::uint8_t[]> age;
   Eye(int w, int h, int max_features, int match_w, int match_h)
       : features(new Feature[static_cast<std::size_t>(std::max(1, max_features))]),
         index(match_w, match_h, max_features),
-        du(w, h),
-        dv(w, h),
-        grey(w, h) {}
+        grey(w, h),
+        age(new std::uint8_t[static_cast<std::size_t>(std::max(1, max_features))]()) {}
 };
 
 struct StereoOdometry::Slot {
@@ -71,7 +72,7 @@ class ConstantVelocity final : public MotionPrediction {
   int scale_;
 };
 
-// The 32-byte descriptor at full-resolution (u, v), as describe() builds it.
+// The 32-byte descriptor at (u, v) of gradient planes, as describe() builds it.
 void descriptor_at(const Plane<std::uint8_t>& du, const Plane<std::uint8_t>& dv, int u, int v,
                    std::uint8_t* out) noexcept {
   Feature f;
@@ -80,6 +81,11 @@ void descriptor_at(const Plane<std::uint8_t>& du, const Plane<std::uint8_t>& dv,
   describe(du, dv, &f, 1);
   std::copy(f.descriptor, f.descriptor + kDescriptorBytes, out);
 }
+
+// How far a descriptor reaches from its centre (vision/feature_detector.cpp).
+constexpr int kDescriptorReach = 5;
+// Beyond the refinement search, no more than the windowed gradients allow.
+constexpr int kMaxRefineRadius = 20;
 
 }  // namespace
 
@@ -97,6 +103,11 @@ StereoOdometry::StereoOdometry(int width, int height, const StereoCameraModel& c
       corner_(width / scale_, height / scale_),
       du_small_(width / scale_, height / scale_),
       dv_small_(width / scale_, height / scale_),
+      ref_du_(2 * kDescriptorReach + 1, 2 * kDescriptorReach + 1),
+      ref_dv_(2 * kDescriptorReach + 1, 2 * kDescriptorReach + 1),
+      win_du_(2 * (std::clamp(params.refine_radius_px, 0, kMaxRefineRadius) + kDescriptorReach) + 1,
+              2 * (std::clamp(params.refine_radius_px, 0, kMaxRefineRadius) + kDescriptorReach) + 1),
+      win_dv_(win_du_.width(), win_du_.height()),
       matcher_(max_features_),
       match_capacity_(max_features_),
       egomotion_(max_features_) {
@@ -113,6 +124,7 @@ StereoOdometry::StereoOdometry(int width, int height, const StereoCameraModel& c
   bucket_slots_.reset(new int[static_cast<std::size_t>(bucket_cols_ * bucket_rows_ * per_bucket)]);
   queries_.reset(new int[static_cast<std::size_t>(std::max(1, max_features_))]);
   observations_.reset(new StereoObservation[static_cast<std::size_t>(std::max(1, match_capacity_))]);
+  observation_match_.reset(new int[static_cast<std::size_t>(std::max(1, match_capacity_))]);
 }
 
 StereoOdometry::~StereoOdometry() = default;
@@ -124,23 +136,21 @@ void StereoOdometry::reset() noexcept {
 
 void StereoOdometry::detect(const GreyView& img, Eye& eye) noexcept {
   for (int v = 0; v < img.height; ++v) std::copy(img.row(v), img.row(v) + img.width, eye.grey.row(v));
-  // Full-resolution gradients for refinement; the matching image's for the
-  // descriptors.
-  filters_.sobel5x5(img, eye.du, eye.dv);
+  // The matching image's gradients for the descriptors. Refinement takes
+  // full-resolution gradients only around the few matches it refines
+  // (FeatureFilters::sobel5x5_window): a whole-image pass per eye cost more
+  // than all of refinement.
   GreyView match = img;
   if (scale_ == 2) {
     FeatureFilters::halve(img, half_);
     match = view_of(half_);
-    filters_.sobel5x5(match, du_small_, dv_small_);
   }
+  filters_.sobel5x5(match, du_small_, dv_small_);
   filters_.blob_corner5x5(match, blob_, corner_);
   int dropped = 0;
   const int n = suppress_non_maxima(blob_, corner_, params_.suppression, eye.features.get(), max_features_, &dropped);
-  if (scale_ == 2) {
-    describe(du_small_, dv_small_, eye.features.get(), n);
-  } else {
-    describe(eye.du, eye.dv, eye.features.get(), n);
-  }
+  describe(du_small_, dv_small_, eye.features.get(), n);
+  std::fill(eye.age.get(), eye.age.get() + n, std::uint8_t{0});
   eye.index.build(eye.features.get(), n);
 }
 
@@ -183,6 +193,15 @@ int StereoOdometry::bucket_of(int u, int v) const noexcept {
   return bv * bucket_cols_ + bu;
 }
 
+int StereoOdometry::priority(const Eye& eye, int i) const noexcept {
+  // A feature that has agreed with the motion for frames in a row is more
+  // likely a static, well-localised point than a new one (Cvisic et al.,
+  // SOFT, 2017): its age comes first, its response breaks ties.
+  const int strength = std::abs(static_cast<int>(eye.features[i].value));  // < 2^13
+  const int age = std::min(static_cast<int>(eye.age[i]), std::max(0, params_.age_priority_cap));
+  return (age << 16) + strength;
+}
+
 int StereoOdometry::select_queries(const Eye& prev_left) noexcept {
   const Feature* f = prev_left.features.get();
   const int n = prev_left.index.size();
@@ -192,17 +211,22 @@ int StereoOdometry::select_queries(const Eye& prev_left) noexcept {
   }
   return keep_strongest(
       n, bucket_cols_ * bucket_rows_, params_.queries_per_bucket, [&](int i) { return bucket_of(f[i].u, f[i].v); },
-      [&](int i) { return std::abs(static_cast<int>(f[i].value)); }, bucket_slots_.get(), queries_.get());
+      [&](int i) { return priority(prev_left, i); }, bucket_slots_.get(), queries_.get());
 }
 
-int StereoOdometry::bucket(const Slot& cur, int n) noexcept {
-  // Per bucket, the bucket_max matches whose current-left feature responds
-  // most strongly, kept in match order.
+int StereoOdometry::bucket(const Slot& prev, const Slot& cur, int n) noexcept {
+  // Per bucket, the bucket_max matches whose previous-left feature has the
+  // highest priority (age, then the current response), kept in match order.
   const Feature* lc = cur.left.features.get();
   const int kept = keep_strongest(
       n, bucket_cols_ * bucket_rows_, std::max(1, params_.bucket_max),
       [&](int m) { return bucket_of(lc[matches_[m].lc].u, lc[matches_[m].lc].v); },
-      [&](int m) { return std::abs(static_cast<int>(lc[matches_[m].lc].value)); }, bucket_slots_.get(), queries_.get());
+      [&](int m) {
+        const CircularMatch& c = matches_[m];
+        return (std::min(static_cast<int>(prev.left.age[c.lp]), std::max(0, params_.age_priority_cap)) << 16) +
+               std::abs(static_cast<int>(lc[c.lc].value));
+      },
+      bucket_slots_.get(), queries_.get());
   for (int i = 0; i < kept; ++i) matches_[i] = matches_[queries_[i]];
   return kept;
 }
@@ -212,10 +236,14 @@ bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMat
   const int s = scale_;
   const Feature& lc = cur.left.features[m.lc];
   const int ru = lc.u * s, rv = lc.v * s;
+  const int r = std::clamp(params_.refine_radius_px, 0, kMaxRefineRadius);
+  // Features keep their margin from the border (at least 2 * kMinFeatureMargin
+  // here), so the reference's window fits; the searches check theirs.
+  const int reach = kDescriptorReach;
   std::uint8_t ref[kDescriptorBytes];
-  descriptor_at(cur.left.du, cur.left.dv, ru, rv, ref);
+  FeatureFilters::sobel5x5_window(view_of(cur.left.grey), ru - reach, rv - reach, ref_du_, ref_dv_);
+  descriptor_at(ref_du_, ref_dv_, reach, reach, ref);
   const bool have_patch = params_.subpixel && aligner_.set_reference(cur.left.grey, ru, rv);
-  const int r = params_.refine_radius_px;
   // The position in `eye` (full resolution) whose descriptor is closest to
   // the reference, near (u0, v0); sub-pixel by a parabola through the costs.
   auto locate = [&](const Eye& eye, const Feature& f, double* u, double* v) {
@@ -227,9 +255,11 @@ bool StereoOdometry::refine(const Slot& prev, const Slot& cur, const CircularMat
     }
     int best = INT_MAX, bu = 0, bv = 0;
     std::uint8_t d[kDescriptorBytes];
+    const int o = r + reach;  // (u0, v0) in the window
+    FeatureFilters::sobel5x5_window(view_of(eye.grey), u0 - o, v0 - o, win_du_, win_dv_);
     for (int dv = -r; dv <= r; ++dv) {
       for (int du = -r; du <= r; ++du) {
-        descriptor_at(eye.du, eye.dv, u0 + du, v0 + dv, d);
+        descriptor_at(win_du_, win_dv_, o + du, o + dv, d);
         const int c = descriptor_sad(ref, d);
         if (c < best) best = c, bu = du, bv = dv;
       }
@@ -284,10 +314,10 @@ StereoOdometryResult StereoOdometry::process(const GreyView& left, const GreyVie
                        matches_.get(), match_capacity_, queries_.get(), queries);
   }
   res.matches = n;
-  n = bucket(cur, n);
+  n = bucket(prev, cur, n);
   int obs = 0;
   for (int i = 0; i < n; ++i) {
-    if (refine(prev, cur, matches_[i], &observations_[obs])) ++obs;
+    if (refine(prev, cur, matches_[i], &observations_[obs])) observation_match_[obs++] = i;
   }
   res.bucketed = obs;
   cur_ = 1 - cur_;
@@ -302,6 +332,12 @@ StereoOdometryResult StereoOdometry::process(const GreyView& left, const GreyVie
     res.status = VoStatus::kNoConsensus;
     have_motion_ = false;
     return res;
+  }
+  for (int i = 0; i < obs; ++i) {
+    if (!egomotion_.inlier(i)) continue;
+    const CircularMatch& m = matches_[observation_match_[i]];
+    cur.left.age[m.lc] = static_cast<std::uint8_t>(std::min(255, prev.left.age[m.lp] + 1));
+    if (prev.left.age[m.lp] > 0) ++res.tracked;
   }
   res.status = VoStatus::kMotion;
   last_motion_ = res.motion;

@@ -2,8 +2,9 @@
 // Frame-to-frame stereo visual odometry on rectified grey pairs (the
 // VISO2-S scheme): features at half resolution in both eyes, circular
 // matching against the previous pair (guided by the previous motion when
-// there is one), an even spread of matches (buckets), sub-pixel positions
-// at full resolution, and RANSAC + Gauss-Newton egomotion with covariance.
+// there is one), an even spread of matches (buckets, preferring features
+// that have been inliers for frames in a row), sub-pixel positions at full
+// resolution, and RANSAC + Gauss-Newton egomotion with covariance.
 //
 // Pure: no threads, no clock, no I/O. Every buffer is sized in the
 // constructor from the image size; process() allocates nothing, and gives
@@ -36,6 +37,9 @@ struct StereoOdometryParams {
   // bucket (0: at every feature): most circles are discarded by the
   // buckets anyway, so this keeps the matching's cost to what is used.
   int queries_per_bucket = 8;
+  // Ages (frames in a row as an inlier) above this count no more when
+  // choosing queries and matches; 0 chooses by response alone.
+  int age_priority_cap = 255;
   int refine_radius_px = 2;         // full-resolution search around a match
   bool subpixel = true;             // align the current-left patch in the other images (vision/patch_aligner)
   EgomotionParams egomotion;
@@ -58,6 +62,7 @@ struct StereoOdometryResult {
   int features_right = 0;
   int matches = 0;            // circles closed
   int bucketed = 0;           // kept after the spread
+  int tracked = 0;            // inliers whose feature was an inlier the frame before too
   bool predicted = false;     // the search followed the previous motion
 };
 
@@ -83,8 +88,9 @@ class StereoOdometry {
   struct Slot;
   void detect(const GreyView& img, Eye& eye) noexcept;
   int bucket_of(int u, int v) const noexcept;  // matching-resolution position
+  int priority(const Eye& eye, int i) const noexcept;
   int select_queries(const Eye& prev_left) noexcept;
-  int bucket(const Slot& cur, int n) noexcept;
+  int bucket(const Slot& prev, const Slot& cur, int n) noexcept;
   bool refine(const Slot& prev, const Slot& cur, const CircularMatch& m, StereoObservation* out) noexcept;
 
   int width_, height_, scale_;
@@ -96,6 +102,7 @@ class StereoOdometry {
   Plane<std::uint8_t> half_;
   Plane<std::int16_t> blob_, corner_;
   Plane<std::uint8_t> du_small_, dv_small_;
+  Plane<std::uint8_t> ref_du_, ref_dv_, win_du_, win_dv_;  // full-resolution gradients around a refined match
   std::unique_ptr<Slot> slots_[2];
   int cur_ = 0;
   bool have_prev_ = false;
@@ -108,6 +115,7 @@ class StereoOdometry {
   std::unique_ptr<int[]> queries_;  // previous-left features that start a circle; kept matches
   int bucket_cols_, bucket_rows_;
   std::unique_ptr<StereoObservation[]> observations_;
+  std::unique_ptr<int[]> observation_match_;  // per observation, its match
   StereoEgomotion egomotion_;
   PatchAligner aligner_;
 };

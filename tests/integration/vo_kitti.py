@@ -9,9 +9,11 @@ copies of them (symlinks in a temporary folder).
             motion held, a pose line still; a calib.txt without P1, a folder
             without images, not a folder: exit 2 naming the file.
 
-The bounds are this implementation's (issue 10 is under way), close above
-what it reaches, so a change for the worse fails; the issue's targets are
-tighter (0.5 %, 0.2 m, 0.8 deg).
+The bounds are this implementation's (issue 10 is under way), about 15 %
+above what it reaches (0.85 %, 0.32 m, 0.81 deg), so a change for the worse
+fails; the issue's targets are tighter (0.5 %, 0.2 m, 0.8 deg). Most of what
+remains comes from frames 1-11, whose ground truth turns at a constant rate
+while the far points (pure rotation) need about 0.1 deg more yaw per frame.
 """
 import json
 import os
@@ -27,7 +29,7 @@ import matplotlib.image  # noqa: E402
 VO = shlex.split(os.environ["RTFUSE_VO"])
 SEQ = os.path.join(os.environ["RTFUSE_SHARED_DATA"], "kitti", "kitti06_0000_0050")
 
-BOUNDS = {"final_error_pct": 1.0, "ate_rmse_m": 0.40, "final_rotation_error_deg": 1.1}
+BOUNDS = {"final_error_pct": 0.98, "ate_rmse_m": 0.37, "final_rotation_error_deg": 0.94}
 
 
 def fail(msg):

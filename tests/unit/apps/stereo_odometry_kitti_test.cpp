@@ -66,6 +66,14 @@ TEST(StereoOdometryKitti, FrameMotionsFollowTheGroundTruth) {
     EXPECT_GT(r.features_left, 1000);
     EXPECT_GT(r.motion.inliers, 80);
     EXPECT_EQ(r.predicted, k > 1);
+    // Features carry over: from the second motion on, many inliers were
+    // inliers the frame before (none can be at the first).
+    EXPECT_LE(r.tracked, r.motion.inliers);
+    if (k == 1) {
+      EXPECT_EQ(r.tracked, 0);
+    } else {
+      EXPECT_GT(r.tracked, r.motion.inliers / 3) << k;
+    }
     // Camera k-1 -> camera k from the ground truth, against the estimate.
     const Eigen::Matrix4d truth =
         f->seq.ground_truth[static_cast<std::size_t>(k)].inverse() * f->seq.ground_truth[static_cast<std::size_t>(k - 1)];

@@ -92,6 +92,35 @@ TEST(StereoEgomotion, RecoversTheMotionThroughNoiseAndWrongMatches) {
   for (int k = 0; k < 6; ++k) EXPECT_LT(std::abs(e.params[k] - truth[k]), 6.0 * std::sqrt(e.covariance(k, k))) << k;
 }
 
+// The adaptive stop draws far fewer samples when most matches agree, never
+// fewer than the minimum, and finds the motion as well as the full count.
+TEST(StereoEgomotion, StopsSamplingWhenAnotherSampleWouldNotHelp) {
+  const Vec6 truth = motion(0.004, -0.02, 0.001, 0.03, -0.01, -1.0);
+  const Synthetic s = make(truth, 300, 0.3, 0.1, 8);
+  StereoEgomotion ego(1000);
+  EgomotionParams full;
+  full.ransac_confidence = 0.0;
+  const Egomotion a = ego.estimate(kCam, s.obs.data(), 300, full, 3);
+  const Egomotion b = ego.estimate(kCam, s.obs.data(), 300, EgomotionParams{}, 3);
+  ASSERT_TRUE(a.ok);
+  ASSERT_TRUE(b.ok);
+  EXPECT_EQ(a.iterations, full.ransac_iterations);
+  EXPECT_GE(b.iterations, EgomotionParams{}.ransac_min_iterations);
+  EXPECT_LT(b.iterations, 60);
+  // The refinement starts from another best sample: a borderline match
+  // may go either way, the motion stays as close to the truth.
+  EXPECT_NEAR(a.inliers, b.inliers, 3);
+  EXPECT_LT((b.params.head<3>() - truth.head<3>()).cwiseAbs().maxCoeff(), 5e-4);
+  EXPECT_LT((b.params.tail<3>() - truth.tail<3>()).cwiseAbs().maxCoeff(), 0.02);
+  EXPECT_LT((a.params - b.params).cwiseAbs().maxCoeff(), 1e-3);
+  // Half wrong: more samples are needed.
+  const Synthetic worse = make(truth, 300, 0.3, 0.5, 9);
+  const Egomotion c = ego.estimate(kCam, worse.obs.data(), 300, EgomotionParams{}, 3);
+  ASSERT_TRUE(c.ok);
+  EXPECT_GT(c.iterations, b.iterations);
+  EXPECT_LT((c.params.head<3>() - truth.head<3>()).cwiseAbs().maxCoeff(), 1e-3);
+}
+
 TEST(StereoEgomotion, SameInputSameBitsAndNoAllocation) {
   const Synthetic s = make(motion(0.0, 0.05, 0.0, 0.0, 0.0, -0.5), 300, 0.5, 0.2, 2);
   StereoEgomotion ego(1000);
