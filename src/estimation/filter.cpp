@@ -92,6 +92,15 @@ ProcessResult Filter::process_in_order(const Measurement& m) noexcept {
   return r;
 }
 
+const StateVector& Filter::state_at(TimeNs t) const noexcept {
+  if (!params_.smooth_lagged_data || !has_time_ || t >= last_time_) return ekf_.state();
+  for (int i = count_ - 1; i >= 0; --i) {
+    const HistoryEntry& e = history_[static_cast<std::size_t>((head_ + i) % capacity_)];
+    if (e.measurement.stamp <= t) return e.x;
+  }
+  return ekf_.state();
+}
+
 ProcessResult Filter::process_late(const Measurement& m) noexcept {
   // Newest entry at or before the late stamp: the filter as it was then.
   int keep = -1;

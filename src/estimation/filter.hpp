@@ -31,6 +31,12 @@ class Filter {
   bool has_time() const noexcept { return has_time_; }
   TimeNs last_measurement_time() const noexcept { return last_time_; }
   const StateVector& state() const noexcept { return ekf_.state(); }
+  // The estimate as it stood at t, for preparing a measurement stamped t
+  // (lever arms, gravity): a late one re-fused from history must be
+  // prepared with the state it is fused into, not today's. The newest
+  // history entry at or before t; the current state when t is not in the
+  // past or there is no such entry.
+  const StateVector& state_at(TimeNs t) const noexcept;
   StateMatrix covariance() const noexcept { return ekf_.covariance(); }
   const FilterParams& params() const noexcept { return params_; }
 

@@ -93,7 +93,7 @@ void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
   last_arrival_[s.sensor] = now;
 
   est::MeasurementBatch batch;
-  if (models_[s.sensor].convert(s, filter_->state(), fusion_frames_, &batch) != est::SampleRejection::kNone) {
+  if (models_[s.sensor].convert(s, filter_->state_at(s.stamp), fusion_frames_, &batch) != est::SampleRejection::kNone) {
     ++st.rejected_invalid;
     return;
   }
