@@ -28,6 +28,14 @@ const char* const kCameraKeys[] = {"frames",    "fps_milli",       "dropped", "s
                                    "lost",      "reopen_attempts", "reopens", "errors",
                                    "pairs_digest"};
 const int kCameraKeyCount = sizeof(kCameraKeys) / sizeof(kCameraKeys[0]);
+// fps_milli: measurements per second from the capture stamps, x1000;
+// residual_milli_px: the last motion's inlier RMS, 1/1000 px; time_us: the
+// last pair's processing time on the camera thread, and the most so far.
+const char* const kVoKeys[] = {"pairs",      "motions",      "fps_milli",   "skipped",         "too_few_matches",
+                               "no_consensus", "implausible", "restarts",    "matches",         "inliers",
+                               "residual_milli_px", "time_us", "max_time_us"};
+const int kVoKeyCount = sizeof(kVoKeys) / sizeof(kVoKeys[0]);
+static_assert(sizeof(kVoKeys) / sizeof(kVoKeys[0]) <= kMaxDeviceValues, "more VO keys than a device holds");
 static_assert(sizeof(kCameraKeys) / sizeof(kCameraKeys[0]) <= kMaxDeviceValues, "more camera keys than a device holds");
 static_assert(sizeof(kImuKeys) / sizeof(kImuKeys[0]) <= kMaxDeviceValues, "more IMU keys than a device holds");
 static_assert(sizeof(kEncoderNodeKeys) / sizeof(kEncoderNodeKeys[0]) <= kMaxDeviceValues,
@@ -45,6 +53,7 @@ DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
   if (hw.wheel_sensor >= 0) s.wheel_odometry = s.count++;
   if (hw.mpu.enabled) s.imu = s.count++;
   if (hw.camera.enabled) s.camera = s.count++;
+  if (hw.camera.enabled && hw.vo.enabled && hw.vo_sensor >= 0) s.vo = s.count++;
   return s;
 }
 
@@ -98,6 +107,13 @@ int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexc
     std::snprintf(buf, sizeof buf, "%s %s@%d", hw.camera.device.c_str(), hw.camera.resolution.c_str(), hw.camera.fps);
     d.hardware_id = buf;
     keys(d, kCameraKeys, kCameraKeyCount);
+  }
+  if (slots.vo >= 0) {
+    DeviceStatus& d = out[slots.vo];
+    d.name = "visual odometry";
+    std::snprintf(buf, sizeof buf, "%s %s", hw.camera.device.c_str(), hw.camera.frame.c_str());
+    d.hardware_id = buf;
+    keys(d, kVoKeys, kVoKeyCount);
   }
   return slots.count;
 }

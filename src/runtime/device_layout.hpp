@@ -10,13 +10,14 @@
 namespace rtfuse {
 
 // Slot order: CAN bus, then one per encoder node in [[can.node]] order, then
-// wheel odometry, then the IMU, then the camera.
+// wheel odometry, then the IMU, then the camera, then its visual odometry.
 struct DeviceSlots {
   int can_bus = -1;
   int first_node = -1;
   int wheel_odometry = -1;
   int imu = -1;
   int camera = -1;
+  int vo = -1;
   int count = 0;
 };
 
@@ -36,6 +37,8 @@ extern const char* const kImuKeys[];
 extern const int kImuKeyCount;
 extern const char* const kCameraKeys[];
 extern const int kCameraKeyCount;
+extern const char* const kVoKeys[];
+extern const int kVoKeyCount;
 
 // Values in the order of the layout's keys, so the names are written in
 // one place only.

@@ -263,12 +263,30 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     }
     return result;
   }
-  // Each thread device replays the stream named after it.
+  // Each thread device replays the stream named after it; a camera's calls
+  // are in the stream's video log.
   const hal::replay::ReplayStream* device_streams[kMaxThreadDevices] = {};
+  hal::replay::ReplayVideoLog* device_videos[kMaxThreadDevices] = {};
   for (int d = 0; d < pipeline->thread_device_count(); ++d) {
     const int index = stream_index(rec.info, pipeline->thread_device(d).name());
-    if (index >= 0) device_streams[d] = rec.streams[static_cast<std::size_t>(index)].get();
+    if (index < 0) continue;
+    device_streams[d] = rec.streams[static_cast<std::size_t>(index)].get();
+    // Every stream has a video log; a camera's is the one with a video device.
+    const bool has_video = std::any_of(rec.info.devices.begin(), rec.info.devices.end(), [&](const auto& dev) {
+      return dev.stream == index && dev.kind == transport::DeviceKind::kVideo;
+    });
+    if (has_video && static_cast<std::size_t>(index) < rec.videos.size()) {
+      device_videos[d] = rec.videos[static_cast<std::size_t>(index)].get();
+    }
   }
+  auto video_mismatch = [&](int d) {
+    const hal::replay::ReplayVideoLog* v = device_videos[d];
+    if (v == nullptr || v->divergence_kind() != hal::replay::DivergenceKind::kMismatch) return false;
+    result.diverged = true;
+    result.error = "replay diverged from the recording in stream '" + std::string(pipeline->thread_device(d).name()) +
+                   "': " + v->divergence();
+    return true;
+  };
   LoopStats loop_stats;
   loop_stats.rate_hz = cfg.rate_hz;
   loop_stats.period_ns = static_cast<std::int64_t>(1e9 / cfg.rate_hz);
@@ -279,13 +297,17 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     for (int d = 0; d < pipeline->thread_device_count() && !short_of_samples; ++d) {
       ThreadDevice& device = pipeline->thread_device(d);
       const hal::replay::ReplayStream* s = device_streams[d];
+      const hal::replay::ReplayVideoLog* v = device_videos[d];
       const int sensor = device.sensor();
       if (s == nullptr || sensor < 0 || static_cast<int>(t.consumed.size()) <= sensor) continue;
       const std::int64_t target = t.consumed[static_cast<std::size_t>(sensor)];
+      auto more = [&] { return v != nullptr ? !v->diverged() && !v->at_end() : !s->diverged() && !s->at_end(); };
       // The device's thread ran ahead of the loop: replay its calls until
       // the loop has what it took live. A stream that ends or diverges
       // first cannot give more.
-      while (device.samples() < target && !s->diverged() && !s->at_end()) device.step(kDeviceStepTimeoutNs);
+      if (v != nullptr && device.samples() < target) camera_clock.sleep_until(t.time_ns);
+      while (device.samples() < target && more()) device.step(kDeviceStepTimeoutNs);
+      if (video_mismatch(d)) break;
       // Ticking on without the samples the live loop had would publish
       // something it never published: the recording ends here.
       if (device.samples() < target && !s->diverged()) {
@@ -296,6 +318,7 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
         short_of_samples = true;
       }
     }
+    if (result.diverged) break;
     if (short_of_samples) break;
     if (const auto* s = diverged()) {
       stop_diverged(*s);
@@ -312,17 +335,14 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);
   }
-  // Devices that feed no sensor (the camera, until visual odometry) do not
-  // change what a tick publishes: their recorded calls are replayed after
-  // the ticks, through the same driver, in their recorded order.
+  // What a camera did after the last sample the loop took (all of it for a
+  // camera without odometry) changes no tick: its recorded calls are
+  // replayed after the ticks, through the same driver, in their recorded
+  // order, so its counters and digest end where the live camera's did.
   for (int d = 0; d < pipeline->thread_device_count() && !result.diverged && !result.ended_early; ++d) {
     ThreadDevice& device = pipeline->thread_device(d);
-    const int index = stream_index(rec.info, device.name());
-    if (device.sensor() >= 0 || index < 0 || static_cast<std::size_t>(index) >= rec.videos.size() ||
-        !rec.videos[static_cast<std::size_t>(index)]) {
-      continue;
-    }
-    hal::replay::ReplayVideoLog& log = *rec.videos[static_cast<std::size_t>(index)];
+    if (device_videos[d] == nullptr) continue;
+    hal::replay::ReplayVideoLog& log = *device_videos[d];
     camera_clock.sleep_until(t0);
     // Each step makes at least one call unless the driver is backing off,
     // which the free-running clock ends at the next step: bounded.

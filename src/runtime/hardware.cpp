@@ -24,7 +24,7 @@ std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& co
     h->threaded_[h->num_threaded_++] = h->imu_.get();
   }
   if (hw.camera.enabled) {
-    h->camera_ = CameraDevice::create(buses.camera, core, h->slots_.camera, error);
+    h->camera_ = CameraDevice::create(buses.camera, core, h->slots_.camera, h->slots_.vo, error);
     if (!h->camera_) return nullptr;
     h->threaded_[h->num_threaded_++] = h->camera_.get();
   }

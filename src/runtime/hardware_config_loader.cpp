@@ -330,6 +330,27 @@ void read_camera(const Section& s, CameraSection& c, const std::string& config_f
   read_int(s, "preview_downscale", c.preview_downscale, 1, 16);
 }
 
+void read_vo(const Section& s, VoSection& v) {
+  s.reject_unknown({"half_resolution", "ransac_iterations", "inlier_threshold", "min_inliers", "bucket_size",
+                    "bucket_max", "max_interval", "max_speed", "max_turn_rate", "covariance_scale",
+                    "min_linear_sigma", "min_angular_sigma"});
+  v.enabled = true;
+  s.read("half_resolution", v.half_resolution);
+  read_int(s, "ransac_iterations", v.ransac_iterations, 10, 5000);
+  read_number(s, "inlier_threshold", v.inlier_threshold_px, [](double x) { return x > 0 && x <= 20; },
+              "must be > 0 and <= 20 px");
+  read_int(s, "min_inliers", v.min_inliers, 6, 1000);
+  read_int(s, "bucket_size", v.bucket_size_px, 8, 1000);
+  read_int(s, "bucket_max", v.bucket_max, 1, 64);
+  read_number(s, "max_interval", v.max_interval_s, positive_finite, "must be > 0 s and finite");
+  read_number(s, "max_speed", v.max_speed_mps, positive_finite, "must be > 0 m/s and finite");
+  read_number(s, "max_turn_rate", v.max_turn_rate_rad_s, positive_finite, "must be > 0 rad/s and finite");
+  read_number(s, "covariance_scale", v.covariance_scale, positive_finite, "must be > 0 and finite");
+  read_number(s, "min_linear_sigma", v.min_linear_sigma_mps, non_negative_finite, "must be >= 0 m/s and finite");
+  read_number(s, "min_angular_sigma", v.min_angular_sigma_rad_s, non_negative_finite,
+              "must be >= 0 rad/s and finite");
+}
+
 }  // namespace
 
 void read_hardware(const Section& root, RuntimeConfig& cfg) {
@@ -347,6 +368,11 @@ void read_hardware(const Section& root, RuntimeConfig& cfg) {
   if (mpu) read_mpu(Section(mpu, "mpu", d), hw.mpu);
   const toml::table* camera = section_table(root, "camera");
   if (camera) read_camera(Section(camera, "camera", d), hw.camera, cfg.source);
+  const toml::table* vo = section_table(root, "vo");
+  if (vo) {
+    read_vo(Section(vo, "vo", d), hw.vo);
+    if (!camera) Section(vo, "vo", d).table_error("vo", "needs a [camera] section: the odometry runs on its frames");
+  }
   if ((can || mpu || camera) && hw.backend == HalBackend::kNone) {
     const char* name = can ? "can" : (mpu ? "mpu" : "camera");
     const Section s(can ? can : (mpu ? mpu : camera), name, d);
@@ -356,6 +382,8 @@ void read_hardware(const Section& root, RuntimeConfig& cfg) {
   hw.wheel_sensor = find_source(root, cfg, SensorSource::kWheelOdometry, "wheel_odometry", est::SensorKind::kTwist,
                                 "twist", wheels != nullptr, "wheel_odometry");
   hw.mpu_sensor = find_source(root, cfg, SensorSource::kMpu, "mpu", est::SensorKind::kImu, "imu", mpu != nullptr, "mpu");
+  hw.vo_sensor = find_source(root, cfg, SensorSource::kStereoVo, "stereo_vo", est::SensorKind::kTwist, "twist",
+                             vo != nullptr, "vo");
 }
 
 }  // namespace rtfuse::config

@@ -73,7 +73,7 @@ struct CameraRig {
     CameraBuses buses;
     buses.video = &stream;
     buses.clock = &clock;
-    camera = CameraDevice::create(buses, *core, 0, &error);
+    camera = CameraDevice::create(buses, *core, 0, -1, &error);
     s.num_devices = describe_devices(core->config(), s.devices, kMaxDevices);
   }
   const DeviceStatus& status() {

@@ -82,6 +82,16 @@ translation = [0.1, 0, 0.2]
 rpy = [0, 0, 0]
 )";
 
+constexpr const char* kStereoSensor = R"(
+[[sensor]]
+name = "stereo"
+type = "twist"
+source = "stereo_vo"
+config = [false, false, false, false, false, false, true, true, false, false, false, true, false, false, false]
+)";
+
+constexpr const char* kCamera = "[camera]\ncalibration = \"SN1.conf\"\n";  // 2 lines
+
 ConfigLoadResult load(const std::string& text) { return load_config_string(text, "hw.toml"); }
 
 TEST(HardwareConfig, FullRobotLandsInTheStructures) {
@@ -171,6 +181,21 @@ INSTANTIATE_TEST_SUITE_P(
                 kLinux + "[can]\n[[can.node]]\nnode_id = 1\nside = \"left\"\nposition_bits = 12\n[[can.node]]\n"
                          "node_id = 2\nside = \"right\"\n",
                 "hw.toml:7:17: can.node[0].position_bits: must be 8, 16, 24 or 32, got 12"},
+        BadCase{"VoWithoutCamera", kLinux + "[vo]\nmin_inliers = 30\n" + kStereoSensor,
+                "hw.toml:3:1: vo: needs a [camera] section: the odometry runs on its frames"},
+        BadCase{"StereoSourceWithoutVo", kLinux + kCamera + kStereoSensor,
+                "hw.toml:6:1: sensor[0].source: source 'stereo_vo' needs a [vo] section"},
+        BadCase{"VoThresholdOutOfRange", kLinux + kCamera + "[vo]\ninlier_threshold = 50\n" + kStereoSensor,
+                "hw.toml:6:20: vo.inlier_threshold: must be > 0 and <= 20 px, got 50"},
+        BadCase{"VoUnknownKey", kLinux + kCamera + "[vo]\nransac = 100\n" + kStereoSensor,
+                "hw.toml:6:1: vo.ransac: unknown key"},
+        BadCase{"VoNotFused", kLinux + kCamera + "[vo]\n",
+                "hw.toml:5:1: vo: no [[sensor]] with source = 'stereo_vo' fuses it"},
+        BadCase{"StereoSourceAsPose",
+                kLinux + kCamera + "[vo]\n[[sensor]]\nname = \"s\"\ntype = \"pose\"\nsource = \"stereo_vo\"\n"
+                                   "config = [true, true, false, false, false, true, false, false, false, false, "
+                                   "false, false, false, false, false]\n",
+                "hw.toml:6:1: sensor[0].type: source 'stereo_vo' produces type 'twist'"},
         BadCase{"WheelSourceWithoutSection", kLinux + kCan + kWheelSensor,
                 "hw.toml:18:1: sensor[0].source: source 'wheel_odometry' needs a [wheel_odometry] section"},
         BadCase{"WheelsNotFused", kLinux + kCan + kWheels,
