@@ -73,8 +73,9 @@ int main(int argc, char** argv) {
   const rtfuse::Snapshot& s = r.final;
   std::printf("{\"duration_s\": %.3f, \"ticks\": %" PRId64
               ", \"final_error_m\": %.4f, \"rms_error_m\": %.4f, \"final_yaw_error_rad\": %.4f, "
-              "\"raw_final_error_m\": %.4f, \"raw_rms_error_m\": %.4f, \"x\": %.4f, \"y\": %.4f, \"yaw\": %.4f}\n",
-              r.duration_s, r.ticks, r.final_error_m, r.rms_error_m, r.final_yaw_error_rad, r.raw_final_error_m,
-              r.raw_rms_error_m, s.state[0], s.state[1], s.state[5]);
+              "\"max_error_m\": %.4f, \"max_jump_m\": %.4f, \"raw_final_error_m\": %.4f, \"raw_rms_error_m\": %.4f, "
+              "\"x\": %.4f, \"y\": %.4f, \"yaw\": %.4f}\n",
+              r.duration_s, r.ticks, r.final_error_m, r.rms_error_m, r.final_yaw_error_rad, r.max_error_m, r.max_jump_m,
+              r.raw_final_error_m, r.raw_rms_error_m, s.state[0], s.state[1], s.state[5]);
   return 0;
 }

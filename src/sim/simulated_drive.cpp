@@ -1,5 +1,7 @@
 #include "sim/simulated_drive.hpp"
 
+#include <algorithm>
+
 #include <chrono>
 #include <cmath>
 #include <memory>
@@ -59,6 +61,7 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
   loop.rate_hz = cfg.rate_hz;
   loop.period_ns = period;
   double sum_sq = 0.0, raw_sum_sq = 0.0;
+  double last_ex = 0.0, last_ey = 0.0;
   std::int64_t samples = 0, raw_samples = 0;
   DriveProgress prog;
   prog.duration_s = duration;
@@ -85,7 +88,12 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
       if (tap && size > 0) tap->recorder().record_output(kGroundTruthChannel, bytes, size, t);
     }
     if (snap.initialized) {
-      const double e = std::hypot(snap.state[0] - truth.x, snap.state[1] - truth.y);
+      const double ex = snap.state[0] - truth.x, ey = snap.state[1] - truth.y;
+      const double e = std::hypot(ex, ey);
+      if (samples > 0) result.max_jump_m = std::max(result.max_jump_m, std::hypot(ex - last_ex, ey - last_ey));
+      last_ex = ex;
+      last_ey = ey;
+      result.max_error_m = std::max(result.max_error_m, e);
       sum_sq += e * e;
       ++samples;
       result.final_error_m = e;

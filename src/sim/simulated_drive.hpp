@@ -31,6 +31,10 @@ struct DriveResult {
   double final_error_m = 0.0;
   double rms_error_m = 0.0;
   double final_yaw_error_rad = 0.0;
+  double max_error_m = 0.0;
+  // The largest change of the position error from one tick to the next: a
+  // jump of the estimate that the robot did not make.
+  double max_jump_m = 0.0;
   double raw_final_error_m = 0.0;
   double raw_rms_error_m = 0.0;
   Snapshot final;
