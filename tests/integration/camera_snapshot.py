@@ -16,17 +16,18 @@ import numpy  # noqa: E402
 SRC = os.environ["RTFUSE_SOURCE_DIR"]
 TOOL = shlex.split(os.environ["RTFUSE_CAMERA_SNAPSHOT"])
 RTFUSED = shlex.split(os.environ["RTFUSED"])
+from sim_config import without_camera  # noqa: E402  (beside this file)
 
 def sim_config(calibration):
     """config/sim.toml driving straight.toml, its camera's calibration at
-    `calibration` (absolute), or without its [camera] when None."""
+    `calibration` (absolute), or without its [camera] (nor the visual
+    odometry on it: [vo] and its [[sensor]]) when None."""
     with open(os.path.join(SRC, "config", "sim.toml")) as f:
         text = f.read()
     text = text.replace('scenario = "scenarios/demo.toml"',
                         'scenario = "%s"' % os.path.join(SRC, "config", "scenarios", "straight.toml"))
     if calibration is None:
-        at = text.index("\n[camera]\n")
-        return text[:at + 1] + text[text.index("\n[", at + 1) + 1:]
+        return without_camera(text)
     return text.replace('calibration = "calibration/SN10000001.conf"', 'calibration = "%s"' % calibration)
 
 

@@ -13,6 +13,14 @@
                     the simulated stereo camera) replays byte-identically
                     too, every rectified pair included, with the calibration
                     the recording carries;
+  camera_slip       config/sim.toml on config/scenarios/camera_slip.toml (wheels
+                    slipping for 4 s, an uncalibrated gyro): with the visual
+                    odometry fused the final position error is at most half
+                    of what the wheels and the IMU alone leave;
+  plain_wall        config/sim.toml facing the textureless wall: the odometry
+                    rejects those pairs and counts them, the estimate does
+                    not jump, and the drive's recording replays identically,
+                    the odometry's counters included;
   divergence        a recording whose NMT start frame was altered stops the
                     replay with a report naming the event;
   bad_recordings    another config, a truncated file, a plain log without a
@@ -191,6 +199,25 @@ def check_cross_arch(tmp):
         print(f"{name}: {json.dumps(rec)}")
         if rec["outputs_compared"] < 10000 or rec["outputs_identical"] != rec["outputs_compared"]:
             sys.exit(f"FAIL: {name}: {rec['outputs_identical']} of {rec['outputs_compared']} outputs identical")
+    # With frames: the product config (encoders, IMU, stereo camera and its
+    # visual odometry fused) on the 20 s straight; every estimate output and
+    # every rectified pair the same on both architectures.
+    cfg = product_config(tmp, "straight")
+    for name, sim, rep in (("this->other", SIM, other_replay), ("other->this", other_sim, REPLAY)):
+        log = os.path.join(tmp, f"camera_{name.replace('->', '_')}.lcm")
+        p = run([sim, "-q", "-c", cfg, "-o", log])
+        if p.returncode != 0:
+            sys.exit(f"FAIL: {name} with frames: {sim}: exit {p.returncode}\n{p.stdout}{p.stderr}")
+        p = run([rep, "-q", "-l", log])
+        if p.returncode != 0:
+            sys.exit(f"FAIL: {name} with frames: {rep} -l {log}: exit {p.returncode}\n{p.stdout}{p.stderr}")
+        result = json.loads(p.stdout.strip().splitlines()[-1])
+        rec, vo = result["recording"], result["devices"].get("visual odometry", {})
+        print(f"{name} with frames: {json.dumps(rec)}; visual odometry {vo}")
+        if rec["outputs_compared"] < 1000 or rec["outputs_identical"] != rec["outputs_compared"]:
+            sys.exit(f"FAIL: {name} with frames: {rec['outputs_identical']} of {rec['outputs_compared']} identical")
+        if vo.get("motions", 0) < 500:
+            sys.exit(f"FAIL: {name} with frames: the visual odometry measured too little: {vo}")
 
 
 def device_lines(stdout):
@@ -227,6 +254,14 @@ def check_live_record(tmp):
         sys.exit(f"FAIL: the live camera rectified no pair: {p.stdout}")
     if replayed != live:
         sys.exit("FAIL: the replayed camera differs from the live one (frames, digest of the rectified pairs or counters)")
+    # The odometry ran on the same pairs: the same counts and last figures
+    # (its processing times are the machine's, not the recording's).
+    timing = ("time_us", "max_time_us")
+    live_vo = {k: v for k, v in device_lines(p.stdout).get("visual odometry", {}).items() if k not in timing}
+    replayed_vo = {k: v for k, v in result["devices"].get("visual odometry", {}).items() if k not in timing}
+    print(f"visual odometry live: {live_vo}\nvisual odometry replayed: {replayed_vo}")
+    if not live_vo or live_vo.get("motions", 0) < 1 or replayed_vo != live_vo:
+        sys.exit("FAIL: the replayed visual odometry differs from the live one")
 
     # A config of its own, whose calibration file is gone when it replays.
     robot = os.path.join(tmp, "robot")
@@ -250,6 +285,68 @@ def check_live_record(tmp):
     if result["devices"].get("camera") != live or result["recording"]["outputs_identical"] == 0:
         sys.exit(f"FAIL: without its calibration file: {result['devices'].get('camera')} vs live {live}")
     print("replayed with the recorded calibration, its file removed:", result["devices"]["camera"]["frames"], "pairs")
+
+
+def product_config(tmp, scenario, camera_fused=True):
+    """config/sim.toml driving one of config/scenarios, as it is or without
+    the visual odometry (its [vo] table and its [[sensor]])."""
+    with open(os.path.join(SRC, "config", "sim.toml")) as f:
+        text = f.read()
+    text = text.replace('scenario = "scenarios/demo.toml"',
+                        'scenario = "%s"' % os.path.join(SRC, "config", "scenarios", scenario + ".toml"))
+    text = text.replace('calibration = "calibration/', 'calibration = "%s/' % os.path.join(SRC, "config", "calibration"))
+    if not camera_fused:
+        # The camera stays (it renders, so both drives cost the same); only
+        # its odometry goes.
+        at = text.index("\n[vo]\n")
+        text = text[:at + 1] + text[text.index("\n[", at + 1) + 1:]
+        text = text[:text.index("# Visual odometry: the camera")]
+    path = os.path.join(tmp, f"{scenario}_{'vo' if camera_fused else 'novo'}.toml")
+    with open(path, "w") as f:
+        f.write(text)
+    return path
+
+
+def sim_json(cfg, *extra):
+    p = run([SIM, "-q", "-c", cfg] + list(extra))
+    if p.returncode != 0:
+        sys.exit(f"FAIL: rtfuse-sim {cfg}: exit {p.returncode}\n{p.stdout}{p.stderr}")
+    return json.loads(p.stdout.strip().splitlines()[-1])
+
+
+def check_camera_slip(tmp):
+    with_camera = sim_json(product_config(tmp, "camera_slip"))
+    without = sim_json(product_config(tmp, "camera_slip", camera_fused=False))
+    print("encoders + IMU + stereo:", json.dumps(with_camera))
+    print("encoders + IMU:         ", json.dumps(without))
+    if without["final_error_m"] < 1.0:
+        sys.exit("FAIL: the scenario no longer hurts wheels and IMU (final error "
+                 f"{without['final_error_m']} m): it tests nothing")
+    if with_camera["final_error_m"] > 0.5 * without["final_error_m"]:
+        sys.exit(f"FAIL: the camera did not halve the final error: {with_camera['final_error_m']} m with it, "
+                 f"{without['final_error_m']} m without")
+
+
+def check_plain_wall(tmp):
+    cfg = product_config(tmp, "plain_wall")
+    log = os.path.join(tmp, "plain_wall.lcm")
+    drive_result = sim_json(cfg, "-o", log)
+    print(json.dumps(drive_result))
+    result = replay_json(log)
+    rec = result["recording"]
+    if rec["outputs_compared"] < 1000 or rec["outputs_identical"] != rec["outputs_compared"]:
+        sys.exit(f"FAIL: plain wall replay: {rec['outputs_identical']} of {rec['outputs_compared']} identical")
+    vo = result["devices"].get("visual odometry")
+    print("visual odometry:", vo)
+    if not vo:
+        sys.exit("FAIL: no 'visual odometry' device in the replay's diagnostics")
+    rejected = vo["too_few_matches"] + vo["no_consensus"]
+    # Half a metre from the wall the camera sees grey only for several
+    # seconds (30 pairs a second); the rest of the drive is textured.
+    if rejected < 60 or vo["motions"] < 600:
+        sys.exit(f"FAIL: expected the wall's pairs rejected and the rest measured: {vo}")
+    if drive_result["max_jump_m"] > 0.01 or drive_result["final_error_m"] > 0.15:
+        sys.exit(f"FAIL: the estimate jumped or drifted facing the wall: {drive_result}")
 
 
 def check_divergence(tmp):

@@ -181,8 +181,10 @@ msg=$(as_rtfuse /usr/bin/rtfused --config /etc/rtfuse/sim.toml --duration 2 --qu
 grep -q "ticks" <<<"$msg" || die "rtfused with sim.toml printed no summary: $msg"
 
 # The bounds are the encoders' and the IMU's: the drive runs sim.toml without
-# its camera, whose frames would cost minutes of rendering under emulation.
-in_root sh -c "sed '/^\[camera\]/,/^\[\[static_transform\]\]/{/^\[\[static_transform\]\]/!d}' /etc/rtfuse/sim.toml > /tmp/sim_no_camera.toml" ||
+# its camera ([camera] and [vo] up to the next [[static_transform]], and the
+# odometry's [[sensor]] at the end), whose frames would cost minutes of
+# rendering under emulation.
+in_root sh -c "sed -e '/^\[camera\]/,/^\[\[static_transform\]\]/{/^\[\[static_transform\]\]/!d}' -e '/^# Visual odometry: the camera/,\$d' /etc/rtfuse/sim.toml > /tmp/sim_no_camera.toml" ||
   die "cannot write a camera-less copy of /etc/rtfuse/sim.toml in the $arch root"
 json=$(in_root /usr/bin/rtfuse-sim -q --config /tmp/sim_no_camera.toml --scenario /etc/rtfuse/scenarios/straight.toml) ||
   die "rtfuse-sim straight.toml failed in the $arch root"
