@@ -79,9 +79,11 @@ void CameraDevice::run_odometry() noexcept {
   vo_frame_ = f.frame_id;
   const TimeNs start = monotonic_now_ns();
   const bool measured = vo_->process(f, &sample_);
-  vo_->set_time(monotonic_now_ns() - start);
+  const TimeNs done = monotonic_now_ns();
+  vo_->set_time(done - start);
   pool_->release(h);
   if (measured) {
+    vo_->set_latency(done - f.stamp);
     core_.input().push_from_driver(vo_sensor_, sample_);
     vo_samples_.fetch_add(1, std::memory_order_acq_rel);
   }
@@ -94,7 +96,7 @@ void fill_odometry(DeviceStatus& d, const VoStats& v) noexcept {
                     {v.pairs, v.motions, static_cast<std::int64_t>(std::lround(v.measured_hz() * 1000.0)), v.skipped,
                      v.too_few_matches, v.no_consensus, v.implausible, v.restarts, v.last_matches, v.last_inliers,
                      static_cast<std::int64_t>(std::lround(v.last_residual_px * 1000.0)), v.last_time_ns / 1000,
-                     v.max_time_ns / 1000});
+                     v.max_time_ns / 1000, v.last_latency_ns / 1000});
   d.state = vision::to_string(v.last_status);
   switch (v.last_status) {
     case vision::VoStatus::kMotion: d.level = DeviceLevel::kOk; break;

@@ -30,10 +30,11 @@ const char* const kCameraKeys[] = {"frames",    "fps_milli",       "dropped", "s
 const int kCameraKeyCount = sizeof(kCameraKeys) / sizeof(kCameraKeys[0]);
 // fps_milli: measurements per second from the capture stamps, x1000;
 // residual_milli_px: the last motion's inlier RMS, 1/1000 px; time_us: the
-// last pair's processing time on the camera thread, and the most so far.
+// last pair's processing time on the camera thread, and the most so far;
+// latency_us: the last twist's age when pushed (capture to ring).
 const char* const kVoKeys[] = {"pairs",      "motions",      "fps_milli",   "skipped",         "too_few_matches",
                                "no_consensus", "implausible", "restarts",    "matches",         "inliers",
-                               "residual_milli_px", "time_us", "max_time_us"};
+                               "residual_milli_px", "time_us", "max_time_us", "latency_us"};
 const int kVoKeyCount = sizeof(kVoKeys) / sizeof(kVoKeys[0]);
 static_assert(sizeof(kVoKeys) / sizeof(kVoKeys[0]) <= kMaxDeviceValues, "more VO keys than a device holds");
 static_assert(sizeof(kCameraKeys) / sizeof(kCameraKeys[0]) <= kMaxDeviceValues, "more camera keys than a device holds");

@@ -39,6 +39,9 @@ struct VoStats {
   double last_residual_px = 0.0;
   TimeNs last_time_ns = 0;         // processing time of the last pair (CPU of the camera thread)
   TimeNs max_time_ns = 0;
+  // From the pair's capture to its twist in the ring, the last pair's
+  // (live runs: the camera thread's clock; a replay's is its own).
+  TimeNs last_latency_ns = 0;
   // Rate of measurements from the capture stamps.
   TimeNs rate_first_stamp = 0;
   TimeNs rate_last_stamp = 0;
@@ -66,6 +69,7 @@ class VisualOdometry {
   bool process(const FramePool::Frame& pair, est::SensorSample* out) noexcept;
   void count_skipped(std::int64_t n) noexcept { stats_.skipped += n; }
   void set_time(TimeNs cpu_ns) noexcept;
+  void set_latency(TimeNs ns) noexcept { stats_.last_latency_ns = ns; }
 
   const VoStats& stats() const noexcept { return stats_; }
 

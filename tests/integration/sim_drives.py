@@ -256,7 +256,7 @@ def check_live_record(tmp):
         sys.exit("FAIL: the replayed camera differs from the live one (frames, digest of the rectified pairs or counters)")
     # The odometry ran on the same pairs: the same counts and last figures
     # (its processing times are the machine's, not the recording's).
-    timing = ("time_us", "max_time_us")
+    timing = ("time_us", "max_time_us", "latency_us")
     live_vo = {k: v for k, v in device_lines(p.stdout).get("visual odometry", {}).items() if k not in timing}
     replayed_vo = {k: v for k, v in result["devices"].get("visual odometry", {}).items() if k not in timing}
     print(f"visual odometry live: {live_vo}\nvisual odometry replayed: {replayed_vo}")
