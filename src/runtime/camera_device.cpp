@@ -37,6 +37,7 @@ std::unique_ptr<CameraDevice> CameraDevice::create(const CameraBuses& buses, Fus
   // already captured keeps it on the newest one when it falls behind.
   if (vo.enabled) dcfg.max_frames_per_step = std::max(1, c.buffers);
   std::unique_ptr<CameraDevice> d(new CameraDevice(core, device_slot, vo_slot));
+  d->clock_ = buses.clock;
   d->pool_ = std::make_unique<FramePool>(c.pool_frames, dcfg.calibration.width, dcfg.calibration.height);
   d->camera_ = drivers::StereoCamera::create(dcfg, *buses.video, *buses.clock, *d->pool_, error);
   if (!d->camera_) {
@@ -83,7 +84,10 @@ void CameraDevice::run_odometry() noexcept {
   vo_->set_time(done - start);
   pool_->release(h);
   if (measured) {
-    vo_->set_latency(done - f.stamp);
+    // On the camera's own clock, the one its stamps are on (live: the
+    // monotonic clock; a lockstep drive: the simulated one, where no time
+    // passes within a step; a replay: the tick being replayed).
+    vo_->set_latency(clock_->now() - f.stamp);
     core_.input().push_from_driver(vo_sensor_, sample_);
     vo_samples_.fetch_add(1, std::memory_order_acq_rel);
   }

@@ -64,6 +64,7 @@ class CameraDevice final : public ThreadDevice {
   };
 
   FusionCore& core_;
+  hal::Clock* clock_ = nullptr;
   int slot_ = -1;
   int vo_slot_ = -1;
   int vo_sensor_ = -1;

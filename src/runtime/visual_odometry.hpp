@@ -39,8 +39,8 @@ struct VoStats {
   double last_residual_px = 0.0;
   TimeNs last_time_ns = 0;         // processing time of the last pair (CPU of the camera thread)
   TimeNs max_time_ns = 0;
-  // From the pair's capture to its twist in the ring, the last pair's
-  // (live runs: the camera thread's clock; a replay's is its own).
+  // From the pair's capture to its twist in the ring, the last pair's, on
+  // the camera's clock.
   TimeNs last_latency_ns = 0;
   // Rate of measurements from the capture stamps.
   TimeNs rate_first_stamp = 0;

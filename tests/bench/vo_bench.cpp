@@ -4,8 +4,7 @@
 //                            pairs of ../shared/data (1226 x 370), one frame
 //                            per iteration in order (wrapping round after the
 //                            last with a reset), as rtfuse-vo runs it;
-//                            counters: allocations per frame (must be 0),
-//                            inliers and failures.
+//                            counters: bench/vo_pairs_run.hpp's.
 #include <benchmark/benchmark.h>
 
 #include <filesystem>
@@ -14,7 +13,7 @@
 
 #include "apps/grey_png.hpp"
 #include "apps/kitti_sequence.hpp"
-#include "support/alloc_counter.hpp"
+#include "bench/vo_pairs_run.hpp"
 #include "vision/stereo_odometry.hpp"
 
 namespace {
@@ -38,33 +37,12 @@ void BM_StereoOdometryKitti(benchmark::State& state) {
   }
   const int w = left[0].width, h = left[0].height;
   rtfuse::vision::StereoOdometry vo(w, h, seq.camera, rtfuse::vision::StereoOdometryParams{});
-  std::size_t k = 0;
-  std::int64_t frames = 0, inliers = 0, failed = 0;
-  std::size_t allocations = 0;
-  {
-    rtfuse::test::AllocScope allocs;
-    for (auto _ : state) {
-      if (k == left.size()) {
-        k = 0;
-        vo.reset();
-      }
-      const rtfuse::vision::GreyView l{left[k].pixels.data(), w, h, w}, r{right[k].pixels.data(), w, h, w};
-      const rtfuse::vision::StereoOdometryResult res = vo.process(l, r, k);
-      benchmark::DoNotOptimize(res.motion.params.data());
-      if (res.status == rtfuse::vision::VoStatus::kMotion) {
-        inliers += res.motion.inliers;
-      } else if (res.status != rtfuse::vision::VoStatus::kFirstFrame) {
-        ++failed;
-      }
-      ++frames;
-      ++k;
-    }
-    allocations = allocs.count();
+  std::vector<rtfuse::vision::GreyView> lv, rv;
+  for (std::size_t k = 0; k < left.size(); ++k) {
+    lv.push_back({left[k].pixels.data(), w, h, w});
+    rv.push_back({right[k].pixels.data(), w, h, w});
   }
-  state.counters["allocs_per_iter"] =
-      benchmark::Counter(static_cast<double>(allocations), benchmark::Counter::kAvgIterations);
-  state.counters["inliers_per_frame"] = static_cast<double>(inliers) / static_cast<double>(std::max<std::int64_t>(1, frames));
-  state.counters["failed"] = static_cast<double>(failed);
+  rtfuse::bench::run_vo_pairs(state, vo, lv, rv);
 }
 
 BENCHMARK(BM_StereoOdometryKitti)->Unit(benchmark::kMillisecond)->Iterations(100);

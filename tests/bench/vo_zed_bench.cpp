@@ -7,25 +7,21 @@
 //   BM_StereoOdometryZed/672    VGA, 672 x 376 per eye
 //   BM_StereoOdometryZed/1280   HD720, 1280 x 720 per eye
 //
-// Counters: allocations per pair (must be 0), inliers per pair, pairs
-// without a motion, and each pair's own time (steady clock around process)
-// as its median and 99th percentile, p50_ms and p99_ms: the time a pair
-// holds the camera thread. The rendering and rectification are set-up, not
-// timed.
+// Counters: bench/vo_pairs_run.hpp's (p50_ms and p99_ms: the time a pair
+// holds the camera thread). The rendering and rectification are set-up,
+// not timed.
 #include <benchmark/benchmark.h>
 
-#include <algorithm>
-#include <chrono>
 #include <cmath>
 #include <string>
 #include <vector>
 
+#include "bench/vo_pairs_run.hpp"
 #include "drivers/camera/stereo_rectification.hpp"
 #include "drivers/camera/stereo_rectifier.hpp"
 #include "runtime/visual_odometry.hpp"
 #include "sim/camera_world.hpp"
 #include "sim/stereo_renderer.hpp"
-#include "support/alloc_counter.hpp"
 #include "unit/drivers/zed_test_calibrations.hpp"
 
 namespace {
@@ -88,44 +84,12 @@ void BM_StereoOdometryZed(benchmark::State& state) {
   const rtfuse::vision::StereoCameraModel model{r.fx, r.cx, r.cy, r.baseline_m};
   rtfuse::vision::StereoOdometry vo(pairs.width, pairs.height, model,
                                     rtfuse::stereo_odometry_params(rtfuse::VoSection{}));
-  std::size_t k = 0;
-  std::int64_t frames = 0, inliers = 0, failed = 0;
-  std::size_t allocations = 0;
-  std::vector<double> pair_ms;
-  pair_ms.reserve(1 << 16);
-  {
-    rtfuse::test::AllocScope allocs;
-    for (auto _ : state) {
-      if (k == pairs.left.size()) {
-        k = 0;
-        vo.reset();
-      }
-      const int w = pairs.width, h = pairs.height;
-      const rtfuse::vision::GreyView lv{pairs.left[k].data(), w, h, w}, rv{pairs.right[k].data(), w, h, w};
-      const auto start = std::chrono::steady_clock::now();
-      const rtfuse::vision::StereoOdometryResult res = vo.process(lv, rv, k);
-      const std::chrono::duration<double, std::milli> took = std::chrono::steady_clock::now() - start;
-      if (pair_ms.size() < pair_ms.capacity()) pair_ms.push_back(took.count());
-      benchmark::DoNotOptimize(res.motion.params.data());
-      if (res.status == rtfuse::vision::VoStatus::kMotion) {
-        inliers += res.motion.inliers;
-      } else if (res.status != rtfuse::vision::VoStatus::kFirstFrame) {
-        ++failed;
-      }
-      ++frames;
-      ++k;
-    }
-    allocations = allocs.count();
+  std::vector<rtfuse::vision::GreyView> lv, rv;
+  for (std::size_t k = 0; k < pairs.left.size(); ++k) {
+    lv.push_back({pairs.left[k].data(), pairs.width, pairs.height, pairs.width});
+    rv.push_back({pairs.right[k].data(), pairs.width, pairs.height, pairs.width});
   }
-  state.counters["allocs_per_iter"] =
-      benchmark::Counter(static_cast<double>(allocations), benchmark::Counter::kAvgIterations);
-  state.counters["inliers"] = frames > 0 ? static_cast<double>(inliers) / static_cast<double>(frames) : 0.0;
-  state.counters["failed"] = static_cast<double>(failed);
-  if (!pair_ms.empty()) {
-    std::sort(pair_ms.begin(), pair_ms.end());
-    state.counters["p50_ms"] = pair_ms[pair_ms.size() / 2];
-    state.counters["p99_ms"] = pair_ms[std::min(pair_ms.size() - 1, pair_ms.size() * 99 / 100)];
-  }
+  rtfuse::bench::run_vo_pairs(state, vo, lv, rv);
 }
 BENCHMARK(BM_StereoOdometryZed)->Arg(672)->Arg(1280)->Unit(benchmark::kMillisecond);
 

@@ -186,38 +186,27 @@ def check_cross_arch(tmp):
     recorded on the robot (aarch64), replayed on a laptop (x86-64), and back.
     RTFUSE_OTHER_SIM/RTFUSE_OTHER_REPLAY are the other build's programs."""
     other_sim, other_replay = os.environ["RTFUSE_OTHER_SIM"], os.environ["RTFUSE_OTHER_REPLAY"]
-    cfg = write_config(tmp, "demo")
-    for name, sim, rep in (("this->other", SIM, other_replay), ("other->this", other_sim, REPLAY)):
-        log = os.path.join(tmp, f"{name.replace('->', '_')}.lcm")
-        p = run([sim, "-q", "-c", cfg, "-o", log])
-        if p.returncode != 0:
-            sys.exit(f"FAIL: {name}: {sim}: exit {p.returncode}\n{p.stdout}{p.stderr}")
-        p = run([rep, "-q", "-l", log])
-        if p.returncode != 0:
-            sys.exit(f"FAIL: {name}: {rep} -l {log}: exit {p.returncode}\n{p.stdout}{p.stderr}")
-        rec = json.loads(p.stdout.strip().splitlines()[-1])["recording"]
-        print(f"{name}: {json.dumps(rec)}")
-        if rec["outputs_compared"] < 10000 or rec["outputs_identical"] != rec["outputs_compared"]:
-            sys.exit(f"FAIL: {name}: {rec['outputs_identical']} of {rec['outputs_compared']} outputs identical")
-    # With frames: the product config (encoders, IMU, stereo camera and its
-    # visual odometry fused) on the 20 s straight; every estimate output and
-    # every rectified pair the same on both architectures.
-    cfg = product_config(tmp, "straight")
-    for name, sim, rep in (("this->other", SIM, other_replay), ("other->this", other_sim, REPLAY)):
-        log = os.path.join(tmp, f"camera_{name.replace('->', '_')}.lcm")
-        p = run([sim, "-q", "-c", cfg, "-o", log])
-        if p.returncode != 0:
-            sys.exit(f"FAIL: {name} with frames: {sim}: exit {p.returncode}\n{p.stdout}{p.stderr}")
-        p = run([rep, "-q", "-l", log])
-        if p.returncode != 0:
-            sys.exit(f"FAIL: {name} with frames: {rep} -l {log}: exit {p.returncode}\n{p.stdout}{p.stderr}")
-        result = json.loads(p.stdout.strip().splitlines()[-1])
-        rec, vo = result["recording"], result["devices"].get("visual odometry", {})
-        print(f"{name} with frames: {json.dumps(rec)}; visual odometry {vo}")
-        if rec["outputs_compared"] < 1000 or rec["outputs_identical"] != rec["outputs_compared"]:
-            sys.exit(f"FAIL: {name} with frames: {rec['outputs_identical']} of {rec['outputs_compared']} identical")
-        if vo.get("motions", 0) < 500:
-            sys.exit(f"FAIL: {name} with frames: the visual odometry measured too little: {vo}")
+    # The demo drive (200 s, encoders and IMU), then with frames: the product
+    # config (encoders, IMU, stereo camera and its visual odometry fused) on
+    # the 20 s straight, every estimate output and every rectified pair the
+    # same on both architectures.
+    for what, cfg, least in (("demo", write_config(tmp, "demo"), 10000),
+                             ("with frames", product_config(tmp, "straight"), 1000)):
+        for name, sim, rep in (("this->other", SIM, other_replay), ("other->this", other_sim, REPLAY)):
+            log = os.path.join(tmp, f"{what.replace(' ', '_')}_{name.replace('->', '_')}.lcm")
+            p = run([sim, "-q", "-c", cfg, "-o", log])
+            if p.returncode != 0:
+                sys.exit(f"FAIL: {name} {what}: {sim}: exit {p.returncode}\n{p.stdout}{p.stderr}")
+            p = run([rep, "-q", "-l", log])
+            if p.returncode != 0:
+                sys.exit(f"FAIL: {name} {what}: {rep} -l {log}: exit {p.returncode}\n{p.stdout}{p.stderr}")
+            result = json.loads(p.stdout.strip().splitlines()[-1])
+            rec, vo = result["recording"], result["devices"].get("visual odometry")
+            print(f"{name} {what}: {json.dumps(rec)}" + (f"; visual odometry {vo}" if vo else ""))
+            if rec["outputs_compared"] < least or rec["outputs_identical"] != rec["outputs_compared"]:
+                sys.exit(f"FAIL: {name} {what}: {rec['outputs_identical']} of {rec['outputs_compared']} identical")
+            if what == "with frames" and (not vo or vo["motions"] < 500):
+                sys.exit(f"FAIL: {name} {what}: the visual odometry measured too little: {vo}")
 
 
 def device_lines(stdout):
