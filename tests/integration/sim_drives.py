@@ -249,7 +249,9 @@ def check_live_record(tmp):
     live_vo = {k: v for k, v in device_lines(p.stdout).get("visual odometry", {}).items() if k not in timing}
     replayed_vo = {k: v for k, v in result["devices"].get("visual odometry", {}).items() if k not in timing}
     print(f"visual odometry live: {live_vo}\nvisual odometry replayed: {replayed_vo}")
-    if not live_vo or live_vo.get("motions", 0) < 1 or replayed_vo != live_vo:
+    # Under emulation the live camera is too slow for motions (every gap
+    # restarts the odometry); what it did, it must do again in the replay.
+    if not live_vo or live_vo.get("pairs", 0) < 1 or replayed_vo != live_vo:
         sys.exit("FAIL: the replayed visual odometry differs from the live one")
 
     # A config of its own, whose calibration file is gone when it replays.

@@ -11,9 +11,10 @@ copies of them (symlinks in a temporary folder).
 
 The bounds are this implementation's (issue 10 is under way), about 15 %
 above what it reaches (0.85 %, 0.32 m, 0.81 deg), so a change for the worse
-fails; the issue's targets are tighter (0.5 %, 0.2 m, 0.8 deg). Most of what
-remains comes from frames 1-11, whose ground truth turns at a constant rate
-while the far points (pure rotation) need about 0.1 deg more yaw per frame.
+fails; the issue's targets are tighter (0.5 %, 0.2 m, 0.8 deg). Much of what
+remains builds up in frames 1-11, whose ground truth turns at a constant rate
+while the far points (pure rotation) fit it only with about 0.1 deg more yaw
+per frame (docs/performance.md).
 """
 import json
 import os
