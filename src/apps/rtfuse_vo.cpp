@@ -35,17 +35,29 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
+void print_errors(const rtfuse::apps::TrajectoryErrors& e) {
+  std::printf(", \"path_length_m\": %.3f, \"final_error_m\": %.4f, \"final_error_pct\": %.3f, \"ate_rmse_m\": %.4f, "
+              "\"final_rotation_error_deg\": %.4f, \"rpe_translation_m\": %.4f, \"rpe_rotation_deg\": %.4f",
+              e.path_length_m, e.final_error_m, e.final_error_pct, e.ate_rmse_m, e.final_rotation_error_deg,
+              e.rpe_translation_m, e.rpe_rotation_deg);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
   CLI::App app{"rtfuse-vo: stereo visual odometry on a KITTI-layout folder of rectified pairs"};
   std::string dir, out_path, plot_path;
   int max_frames = 0;
+  int eval_from = 0;
   app.add_option("--kitti", dir, "sequence folder: image_l/ image_r/ (or image_0/ image_1/), calib.txt, [poses.txt]")
       ->required();
   app.add_option("-o,--out", out_path, "poses to write, KITTI format");
   app.add_option("--plot", plot_path, "PNG: top view of the trajectory (and the ground truth)");
   app.add_option("-n,--frames", max_frames, "at most this many frames (0: all)");
+  app.add_option("--eval-from", eval_from,
+                 "also judge the frames from this one on against the ground truth, both re-anchored there "
+                 "(\"from_frame\" in the JSON): a stretch whose ground truth is measured")
+      ->check(CLI::NonNegativeNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -59,6 +71,15 @@ int main(int argc, char** argv) {
   }
   std::size_t frames = seq.left.size();
   if (max_frames > 0) frames = std::min(frames, static_cast<std::size_t>(max_frames));
+  if (eval_from > 0 && seq.ground_truth.empty()) {
+    std::fprintf(stderr, "rtfuse-vo: --eval-from needs the ground truth %s/poses.txt\n", dir.c_str());
+    return 2;
+  }
+  if (eval_from > 0 && static_cast<std::size_t>(eval_from) + 1 >= std::min(frames, seq.ground_truth.size())) {
+    std::fprintf(stderr, "rtfuse-vo: --eval-from %d: a stretch needs two frames, and %zu frames have ground truth\n",
+                 eval_from, std::min(frames, seq.ground_truth.size()));
+    return 2;
+  }
   rtfuse::apps::GreyPng first;
   if (!rtfuse::apps::read_grey_png(seq.left[0], &first, &error)) {
     std::fprintf(stderr, "rtfuse-vo: %s\n", error.c_str());
@@ -141,10 +162,14 @@ int main(int argc, char** argv) {
               percentile(ms, 0.5), percentile(ms, 0.99));
   if (!seq.ground_truth.empty()) {
     const rtfuse::apps::TrajectoryErrors e = rtfuse::apps::compare_trajectories(poses, seq.ground_truth);
-    std::printf(", \"path_length_m\": %.3f, \"final_error_m\": %.4f, \"final_error_pct\": %.3f, \"ate_rmse_m\": %.4f, "
-                "\"final_rotation_error_deg\": %.4f, \"rpe_translation_m\": %.4f, \"rpe_rotation_deg\": %.4f",
-                e.path_length_m, e.final_error_m, e.final_error_pct, e.ate_rmse_m, e.final_rotation_error_deg,
-                e.rpe_translation_m, e.rpe_rotation_deg);
+    print_errors(e);
+    if (eval_from > 0) {
+      const auto first = static_cast<std::size_t>(eval_from);
+      std::printf(", \"from_frame\": {\"first\": %d", eval_from);
+      print_errors(rtfuse::apps::compare_trajectories(rtfuse::apps::reanchored(poses, first),
+                                                      rtfuse::apps::reanchored(seq.ground_truth, first)));
+      std::printf("}");
+    }
   }
   std::printf("}\n");
   return 0;

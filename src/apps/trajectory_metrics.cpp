@@ -12,6 +12,14 @@ double rotation_angle_deg(const Eigen::Matrix3d& r) {
   return std::acos(c) * 180.0 / 3.14159265358979323846;
 }
 
+std::vector<Eigen::Matrix4d> reanchored(const std::vector<Eigen::Matrix4d>& poses, std::size_t first) {
+  std::vector<Eigen::Matrix4d> out;
+  if (first >= poses.size()) return out;
+  const Eigen::Matrix4d from = poses[first].inverse();
+  for (std::size_t i = first; i < poses.size(); ++i) out.push_back(from * poses[i]);
+  return out;
+}
+
 TrajectoryErrors compare_trajectories(const std::vector<Eigen::Matrix4d>& est, const std::vector<Eigen::Matrix4d>& gt) {
   TrajectoryErrors e;
   const std::size_t n = std::min(est.size(), gt.size());

@@ -4,6 +4,7 @@
 // position and heading errors, the absolute trajectory error without any
 // alignment (both start at the identity, as a robot's odometry does), and
 // the mean frame-to-frame errors.
+#include <cstddef>
 #include <vector>
 
 #include <Eigen/Core>
@@ -24,6 +25,11 @@ struct TrajectoryErrors {
 // Over the frames both have (the shorter length).
 TrajectoryErrors compare_trajectories(const std::vector<Eigen::Matrix4d>& estimate,
                                       const std::vector<Eigen::Matrix4d>& truth);
+
+// The poses from `first` on, seen from pose `first` (which becomes the
+// identity): to judge a stretch of a trajectory on its own, as if the
+// odometry had started there. Empty when first is past the end.
+std::vector<Eigen::Matrix4d> reanchored(const std::vector<Eigen::Matrix4d>& poses, std::size_t first);
 
 // The rotation angle of a 3x3 rotation, degrees.
 double rotation_angle_deg(const Eigen::Matrix3d& r);

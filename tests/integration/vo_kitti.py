@@ -9,12 +9,14 @@ copies of them (symlinks in a temporary folder).
             motion held, a pose line still; a calib.txt without P1, a folder
             without images, not a folder: exit 2 naming the file.
 
-The bounds are this implementation's (issue 10 is under way), about 15 %
-above what it reaches (0.85 %, 0.32 m, 0.81 deg), so a change for the worse
-fails; the issue's targets are tighter (0.5 %, 0.2 m, 0.8 deg). Much of what
-remains builds up in frames 1-11, whose ground truth turns at a constant rate
-while the far points (pure rotation) fit it only with about 0.1 deg more yaw
-per frame (docs/performance.md).
+The bounds are this implementation's, about 15 % above what it reaches
+(0.85 %, 0.32 m, 0.81 deg over frames 0-50; 0.65 %, 0.18 m, 0.10 deg over
+frames 11-50), so a change for the worse fails. The issue's targets
+(0.5 %, 0.2 m, 0.8 deg) are tighter than frames 0-50 allow: their ground
+truth in frames 1-11 is a constant twist the images do not show
+(tests/reference/opencv_vo_reference_test.cpp, docs/performance.md), so
+frames 11-50, where it is measured, are judged on their own too
+(--eval-from 11).
 """
 import json
 import os
@@ -31,6 +33,7 @@ VO = shlex.split(os.environ["RTFUSE_VO"])
 SEQ = os.path.join(os.environ["RTFUSE_SHARED_DATA"], "kitti", "kitti06_0000_0050")
 
 BOUNDS = {"final_error_pct": 0.98, "ate_rmse_m": 0.37, "final_rotation_error_deg": 0.94}
+BOUNDS_FROM_11 = {"final_error_pct": 0.75, "ate_rmse_m": 0.2, "final_rotation_error_deg": 0.15}
 
 
 def fail(msg):
@@ -72,7 +75,7 @@ def copy_of(tmp, name, right_skip=None, broken=None, calib=None):
 
 def check_kitti(tmp):
     poses, plot = os.path.join(tmp, "poses.txt"), os.path.join(tmp, "plot.png")
-    p = run("--kitti", SEQ, "--out", poses, "--plot", plot)
+    p = run("--kitti", SEQ, "--out", poses, "--plot", plot, "--eval-from", "11")
     if p.returncode != 0:
         fail(f"exit {p.returncode}: {p.stderr}")
     r = summary(p)
@@ -82,6 +85,12 @@ def check_kitti(tmp):
     for k, bound in BOUNDS.items():
         if r[k] > bound:
             fail(f"{k} {r[k]} above {bound}")
+    w = r["from_frame"]
+    if w["first"] != 11 or not 46.0 < w["path_length_m"] < 47.5:
+        fail(f"from frame 11: {w}")
+    for k, bound in BOUNDS_FROM_11.items():
+        if w[k] > bound:
+            fail(f"from frame 11: {k} {w[k]} above {bound}")
     lines = open(poses).read().splitlines()
     if len(lines) != 51 or [float(x) for x in lines[0].split()] != [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0]:
         fail(f"{len(lines)} pose lines, the first {lines[0] if lines else None}")
@@ -103,6 +112,10 @@ def check_bad(tmp):
         fail("holes: the frames are not named")
     if r["final_error_pct"] > 3.0:
         fail(f"holes: the last motion held should keep the path: {r['final_error_pct']} %")
+    p = run("--kitti", SEQ, "--eval-from", "50")
+    if p.returncode != 2 or "a stretch needs two frames" not in p.stderr:
+        fail(f"--eval-from 50: exit {p.returncode}, {p.stderr}")
+    print(p.stderr.strip())
     d = copy_of(tmp, "no_p1", calib=open(os.path.join(SEQ, "calib.txt")).read().splitlines()[0] + "\n")
     p = run("--kitti", d)
     if p.returncode != 2 or "no P1" not in p.stderr or "calib.txt" not in p.stderr:

@@ -93,5 +93,24 @@ TEST(TrajectoryErrors, KnownAnswers) {
   EXPECT_EQ(compare_trajectories({}, gt).frames, 0);
 }
 
+TEST(TrajectoryErrors, ReanchoredJudgesAStretchAsIfItStartedThere) {
+  // The estimate turns 0.01 rad at frame 3 and is exact after it: from
+  // frame 3 on it drives a straight line like the ground truth, only turned.
+  std::vector<Eigen::Matrix4d> gt, est;
+  for (int i = 0; i <= 10; ++i) {
+    gt.push_back(at(0.0, i));
+    est.push_back(i < 3 ? at(0.0, i) : at(0.0, 2.0) * at(0.0, 1.0, 0.01) * at(0.0, i - 3));
+  }
+  EXPECT_GT(compare_trajectories(est, gt).final_rotation_error_deg, 0.5);
+  const std::vector<Eigen::Matrix4d> e = reanchored(est, 4), g = reanchored(gt, 4);
+  ASSERT_EQ(e.size(), 7u);
+  EXPECT_TRUE(e[0].isApprox(Eigen::Matrix4d::Identity(), 1e-15));
+  const TrajectoryErrors w = compare_trajectories(e, g);
+  EXPECT_NEAR(w.path_length_m, 6.0, 1e-12);
+  EXPECT_NEAR(w.final_error_m, 0.0, 1e-12);
+  EXPECT_NEAR(w.final_rotation_error_deg, 0.0, 1e-6);
+  EXPECT_TRUE(reanchored(est, 11).empty());
+}
+
 }  // namespace
 }  // namespace rtfuse::apps
