@@ -1,5 +1,7 @@
 #include "runtime/toml_reader.hpp"
 
+#include "runtime/toml_guard.hpp"
+
 #include <algorithm>
 #include <iomanip>
 #include <sstream>
@@ -110,6 +112,14 @@ std::vector<ConfigError> Diagnostics::take() {
 }
 
 std::optional<toml::table> parse(std::string_view text, const std::string& source_name, Diagnostics& diag) {
+  // What would abort or misbehave in toml++ never reaches it (toml_guard.hpp).
+  if (const std::optional<TomlHazard> h = find_toml_hazard(text)) {
+    toml::source_region where;
+    where.begin = {static_cast<toml::source_index>(h->line), static_cast<toml::source_index>(h->column)};
+    where.end = where.begin;
+    diag.add(where, "", h->message);
+    return std::nullopt;
+  }
 #if TOML_EXCEPTIONS
   try {
     return toml::parse(text, std::string_view(source_name));
