@@ -53,12 +53,23 @@ void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::Snapshot& s, std
   std::printf("}%s}\n", extra.c_str());
 }
 
-bool is_hal_recording(const std::string& path) {
+enum class LogKind { kHalRecording, kLcmLog, kEmpty, kUnreadable };
+
+// What the log is, from its first event; kUnreadable with the reader's
+// words (cannot open, a directory, truncated, not an LCM log).
+LogKind classify_log(const std::string& path, std::string* error) {
   rtfuse::transport::EventLogReader in;
   rtfuse::transport::LogEvent ev;
-  std::string error;
-  return in.open(path, &error) && in.next(&ev, &error) == rtfuse::transport::ReadStatus::kEvent &&
-         ev.channel == rtfuse::transport::kRecordingInfoChannel;
+  if (!in.open(path, error)) return LogKind::kUnreadable;
+  switch (in.next(&ev, error)) {
+    case rtfuse::transport::ReadStatus::kEvent:
+      return ev.channel == rtfuse::transport::kRecordingInfoChannel ? LogKind::kHalRecording : LogKind::kLcmLog;
+    case rtfuse::transport::ReadStatus::kEnd:
+      return LogKind::kEmpty;
+    case rtfuse::transport::ReadStatus::kError:
+      break;
+  }
+  return LogKind::kUnreadable;
 }
 
 
@@ -164,7 +175,20 @@ int main(int argc, char** argv) {
   }
 
   const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
-  if (is_hal_recording(log_path)) return replay_recording(log_path, config_path, out_path, allow_truncated, tty);
+  std::string why;
+  const LogKind kind = classify_log(log_path, &why);
+  if (kind == LogKind::kUnreadable) {
+    std::fprintf(stderr, "rtfuse-replay: %s\n", why.c_str());
+    return 1;
+  }
+  if (kind == LogKind::kHalRecording) return replay_recording(log_path, config_path, out_path, allow_truncated, tty);
+  // An empty log with --config replays nothing: how tools/deploy.sh has a
+  // configuration checked by the loop that will run it.
+  if (kind == LogKind::kEmpty && config_path.empty()) {
+    std::fprintf(stderr, "rtfuse-replay: %s is empty: no event to replay (with --config it checks the configuration)\n",
+                 log_path.c_str());
+    return 1;
+  }
   if (config_path.empty()) {
     std::fprintf(stderr, "rtfuse-replay: %s is not a HAL recording: give its configuration with --config\n",
                  log_path.c_str());

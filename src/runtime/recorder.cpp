@@ -2,6 +2,7 @@
 
 #include <pthread.h>
 
+#include <algorithm>
 #include <chrono>
 #include <cstring>
 #include <exception>
@@ -187,6 +188,14 @@ bool Recorder::stop(std::string* error) {
       while (drain_once() > 0) {
       }
     }
+    // Last, the end record: a log without it was cut short, even between
+    // two events. Stamped with the newest event's time, not the clock, so
+    // a lockstep simulation records the same bytes every run.
+    std::int64_t lost = ticks_lost_.load() + outputs_lost_.load() + write_errors_.load();
+    for (std::size_t i = 0; i < info_.streams.size(); ++i) lost += bus_lost_[i].load();
+    const std::vector<std::uint8_t> end =
+        transport::encode_recording_end({utime_to_ns(last_utime_), writer_.events_written(), lost});
+    write(last_utime_, transport::kRecordingEndChannel, end.data(), end.size());
     std::string why;
     if (!writer_.close(&why)) {
       write_errors_.fetch_add(1, std::memory_order_relaxed);
@@ -228,6 +237,7 @@ void Recorder::write(std::int64_t utime, std::string_view channel, const std::ui
     return;
   }
   events_written_.fetch_add(1, std::memory_order_relaxed);
+  last_utime_ = std::max(last_utime_, utime);
   bytes_written_.fetch_add(static_cast<std::int64_t>(transport::kEventHeaderSize + channel.size() + size),
                            std::memory_order_relaxed);
 }

@@ -181,6 +181,7 @@ class Recorder {
   std::atomic<bool> stop_requested_{false};
   bool stopped_ = false;
   std::string first_error_;  // writer thread; read after join
+  std::int64_t last_utime_ = 0;  // writer thread: the newest event's stamp, for the end record
 
   std::atomic<std::int64_t> events_written_{0};
   std::atomic<std::int64_t> bytes_written_{0};

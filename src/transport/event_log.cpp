@@ -1,12 +1,15 @@
 #include "transport/event_log.hpp"
 
 #include <fcntl.h>
+#include <sys/stat.h>
 #include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
 #include <new>
 #include <utility>
+
+#include "core/time.hpp"
 
 namespace rtfuse::transport {
 namespace {
@@ -63,6 +66,14 @@ bool EventLogReader::open(const std::string& path, std::string* error) {
   file_ = std::fopen(path.c_str(), "rb");
   if (file_ == nullptr) {
     set_error(error, "cannot open log file " + path + ": " + std::strerror(errno));
+    return false;
+  }
+  // glibc opens a directory for reading; say so now rather than as a read
+  // error later.
+  struct stat st {};
+  if (::fstat(::fileno(file_), &st) == 0 && S_ISDIR(st.st_mode)) {
+    close();
+    set_error(error, "cannot open log file " + path + ": it is a directory (give the .lcm file in it)");
     return false;
   }
   return true;
@@ -123,6 +134,11 @@ ReadStatus EventLogReader::next(LogEvent* ev, std::string* error) {
   const auto timestamp = static_cast<std::int64_t>(load_u64(header + 12));
   const auto channel_len = static_cast<std::int32_t>(load_u32(header + 20));
   const auto data_len = static_cast<std::int32_t>(load_u32(header + 24));
+  if (!utime_in_range(timestamp)) {
+    return fail(error, prefix() + " has the timestamp " + std::to_string(timestamp) +
+                           " us, beyond what nanoseconds can hold (+-" + std::to_string(kMaxUtime) +
+                           " us): the log is corrupt");
+  }
   if (channel_len <= 0 || channel_len > kMaxEventChannelSize) {
     return fail(error, prefix() + " has an invalid channel length " + std::to_string(channel_len) +
                            " (expected 1.." + std::to_string(kMaxEventChannelSize) +

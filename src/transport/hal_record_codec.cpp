@@ -11,6 +11,7 @@
 #include "rtfuse/hal_i2c_t.hpp"
 #include "rtfuse/hal_video_t.hpp"
 #include "rtfuse/loop_tick_t.hpp"
+#include "rtfuse/recording_end_t.hpp"
 #include "rtfuse/recording_file_t.hpp"
 #include "rtfuse/recording_info_t.hpp"
 #include "transport/encode_buffer.hpp"
@@ -56,6 +57,20 @@ int after_device_string(const std::uint8_t* b, int size) {
   const std::int32_t len = load_i32(b + kAt);
   if (len < 1 || len > size - kAt - 4) return -1;
   return kAt + 4 + len;
+}
+
+// n LCM strings from `at` (an int32 length counting the NUL, then the
+// bytes), each of 0..max_chars characters and all within the record:
+// the offset just past them, or -1. lcm-gen's decoder copies len - 1 bytes
+// for any length, so a length of 0 or 2^31 must never reach it.
+int after_strings(const std::uint8_t* b, int size, int at, int n, std::int64_t max_chars) {
+  for (int i = 0; i < n; ++i) {
+    if (at < 0 || size - at < 4) return -1;
+    const std::int32_t len = load_i32(b + at);
+    if (len < 1 || len - 1 > max_chars || len > size - at - 4) return -1;
+    at += 4 + len;
+  }
+  return at;
 }
 
 bool count_within(const std::uint8_t* b, int size, int at, int max) {
@@ -252,10 +267,23 @@ bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::
     set_error(error, "not a recording_info_t: too short, or stream/device counts out of range");
     return false;
   }
+  // Then every string: version, config path and text, the stream and device
+  // names (counts bounded just above).
+  constexpr int kStringsAt = 36;
+  if (after_strings(b, size, kStringsAt, 3 + load_i32(b + 28) + load_i32(b + 32), size) < 0) {
+    set_error(error, "malformed recording_info_t: a string length is out of range or past the record's " +
+                         std::to_string(size) + " bytes");
+    return false;
+  }
   rtfuse::recording_info_t m;
   if (!decode_message(m, data, size, "recording_info_t", error)) return false;
   RecordingInfo info;
   info.format_version = m.format_version;
+  if (!utime_in_range(m.utime)) {
+    set_error(error, "recording_info_t: start time " + std::to_string(m.utime) +
+                         " us is beyond what nanoseconds can hold: the recording is corrupt");
+    return false;
+  }
   info.start_ns = utime_to_ns(m.utime);
   info.rtfuse_version = m.rtfuse_version;
   info.config_path = m.config_path;
@@ -288,20 +316,39 @@ std::vector<std::uint8_t> encode_recorded_file(const RecordedFile& file) {
   return bytes;
 }
 
+std::vector<std::uint8_t> encode_recording_end(const RecordingEnd& end) {
+  rtfuse::recording_end_t m;
+  m.utime = ns_to_utime(end.end_ns);
+  m.events = end.events;
+  m.lost_events = end.lost_events;
+  std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+  m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+  return bytes;
+}
+
+bool decode_recording_end(const void* data, int size, RecordingEnd* out, std::string* error) {
+  rtfuse::recording_end_t m;
+  if (!decode_message(m, data, size, "recording_end_t", error)) return false;
+  if (!utime_in_range(m.utime)) return bad_field(error, "recording_end_t", "utime", m.utime);
+  if (m.events < 1) return bad_field(error, "recording_end_t", "event count", m.events);
+  if (m.lost_events < 0) return bad_field(error, "recording_end_t", "lost event count", m.lost_events);
+  *out = RecordingEnd{utime_to_ns(m.utime), m.events, m.lost_events};
+  return true;
+}
+
 bool decode_recorded_file(const void* data, int size, RecordedFile* out, std::string* error) {
   const auto* b = static_cast<const std::uint8_t*>(data);
   // Both strings and the byte count bounded before lcm-gen's decoder sizes
   // anything from them (see after_device_string).
   int at = 8;
   for (const std::size_t max : {kMaxRecordedFileKeyLength, kMaxRecordedFilePathLength}) {
-    if (b == nullptr || size - at < 4) break;
-    const std::int32_t len = load_i32(b + at);
-    if (len < 1 || static_cast<std::size_t>(len) > max + 1 || len > size - at - 4) {
-      set_error(error, "malformed recording_file_t: a string length of " + std::to_string(len) + " at byte " +
-                           std::to_string(at));
+    const int next = b == nullptr ? -1 : after_strings(b, size, at, 1, static_cast<std::int64_t>(max));
+    if (next < 0) {
+      set_error(error, "malformed recording_file_t: the string at byte " + std::to_string(at) +
+                           " has an impossible length");
       return false;
     }
-    at += 4 + len;
+    at = next;
   }
   if (b == nullptr || !count_within(b, size, at, static_cast<int>(kMaxRecordedFileBytes))) {
     set_error(error, "malformed recording_file_t: too short, or more than " + std::to_string(kMaxRecordedFileBytes) +
@@ -748,6 +795,12 @@ bool HalRecordCodec::decode_tick(const void* data, int size, LoopTick* out, std:
   }
   rtfuse::loop_tick_t m;
   if (!decode_message(m, data, size, "loop_tick_t", error)) return false;
+  // The loop counts its ticks from 0; a negative count is corrupt, and
+  // keeping counts non-negative keeps the loader's gap arithmetic in range.
+  if (m.seq < 0) {
+    set_error(error, "loop_tick_t: negative tick seq " + std::to_string(m.seq));
+    return false;
+  }
   out->time_ns = m.time_ns;
   out->seq = m.seq;
   out->consumed = std::move(m.consumed);
@@ -816,28 +869,42 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
     return false;
   };
 
+  bool ended = false;
+  // A log cut short: mid-event, or between two events without the end
+  // record. Allowed, its complete events are kept.
+  auto cut_short = [&](const std::string& how, const std::string& detail) {
+    const std::int64_t complete = reader.events_read();
+    const std::string what = "file " + path + ": " + how + " after event " + std::to_string(complete - 1) +
+                             ", the recorder was probably killed or lost power";
+    if (!options.allow_truncated) {
+      set_error(error, what + ": replay the first " + std::to_string(complete) + " events with --allow-truncated (" +
+                           detail + ")");
+      return false;
+    }
+    rec.truncated = true;
+    rec.warnings.push_back(what + ": replaying its first " + std::to_string(complete) + " events");
+    return true;
+  };
+
   for (;;) {
     st = reader.next(&ev, &read_error);
-    if (st == ReadStatus::kEnd) break;
+    if (st == ReadStatus::kEnd) {
+      if (!ended && !cut_short("ends", "no rtfuse/rec/end record, which a recorder that stops writes last")) {
+        return false;
+      }
+      break;
+    }
     if (st == ReadStatus::kError) {
       const bool truncated = read_error.find("the log ends mid-event") != std::string::npos;
       if (!truncated) {
         set_error(error, read_error);
         return false;
       }
-      const std::int64_t complete = reader.events_read();
-      const std::string what = "file " + path + ": truncated after event " + std::to_string(complete - 1) +
-                               ", the recorder was probably killed";
-      if (!options.allow_truncated) {
-        set_error(error, what + ": replay the first " + std::to_string(complete) +
-                             " events with --allow-truncated (" + read_error + ")");
-        return false;
-      }
-      rec.truncated = true;
-      rec.warnings.push_back(what + ": replaying its first " + std::to_string(complete) + " events");
+      if (!cut_short("truncated", read_error)) return false;
       break;
     }
     ++rec.events;
+    if (ended) return undecodable(ev, "an event after the end of the recording (two recordings concatenated?)");
     const int size = static_cast<int>(ev.size);
     DeviceKind kind = DeviceKind::kCan;
     if (starts_with(ev.channel, kHalChannelPrefix) && codec.kind_of(codec.device_of(ev.channel), &kind) &&
@@ -886,11 +953,14 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
     } else if (ev.channel == kLoopTickChannel) {
       LoopTick tick;
       if (!HalRecordCodec::decode_tick(ev.data, size, &tick, &why)) return undecodable(ev, why);
-      if (have_tick && tick.seq != last_seq + 1) {
-        if (tick.seq <= last_seq) return undecodable(ev, "tick seq " + std::to_string(tick.seq) + " after " +
-                                                             std::to_string(last_seq) + " goes backwards");
-        rec.missing_ticks += tick.seq - last_seq - 1;
+      // Seqs are >= 0 (decode_tick) and rise, so differences cannot
+      // overflow and the gaps add up to at most the last seq; last_seq + 1
+      // could overflow, for a seq of INT64_MAX.
+      if (have_tick && tick.seq <= last_seq) {
+        return undecodable(ev, "tick seq " + std::to_string(tick.seq) + " after " + std::to_string(last_seq) +
+                                   " goes backwards");
       }
+      if (have_tick) rec.missing_ticks += tick.seq - last_seq - 1;
       have_tick = true;
       last_seq = tick.seq;
       rec.ticks.push_back(std::move(tick));
@@ -899,6 +969,14 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
       if (!decode_recorded_file(ev.data, size, &file, &why)) return undecodable(ev, why);
       rec.info.files.push_back(std::move(file));
       if (!validate(rec.info, &why)) return undecodable(ev, why);
+    } else if (ev.channel == kRecordingEndChannel) {
+      RecordingEnd end;
+      if (!decode_recording_end(ev.data, size, &end, &why)) return undecodable(ev, why);
+      if (end.events != rec.events - 1) {
+        return undecodable(ev, "the end record counts " + std::to_string(end.events) + " events before it, the log holds " +
+                                   std::to_string(rec.events - 1) + ": events are missing or were added");
+      }
+      ended = true;
     } else if (starts_with(ev.channel, kRecordChannelPrefix)) {
       return undecodable(ev, ev.channel == kRecordingInfoChannel
                                  ? std::string("a second recording_info_t (two recordings concatenated?)")

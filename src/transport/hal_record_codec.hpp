@@ -31,11 +31,13 @@
 namespace rtfuse::transport {
 
 // Bump when a rtfuse/hal/* or rtfuse/rec/* record changes meaning or layout.
-constexpr std::int32_t kHalRecordFormatVersion = 2;
+// 3: a recording ends with its rtfuse/rec/end record.
+constexpr std::int32_t kHalRecordFormatVersion = 3;
 
 constexpr std::string_view kRecordingInfoChannel = "rtfuse/rec/info";
 constexpr std::string_view kLoopTickChannel = "rtfuse/rec/tick";
 constexpr std::string_view kRecordedFileChannel = "rtfuse/rec/file";
+constexpr std::string_view kRecordingEndChannel = "rtfuse/rec/end";
 constexpr std::string_view kRecordChannelPrefix = "rtfuse/rec/";
 constexpr std::string_view kHalChannelPrefix = "rtfuse/hal/";
 
@@ -108,6 +110,16 @@ std::vector<std::uint8_t> encode_recorded_file(const RecordedFile& file);
 // Fails on bytes that are not a recording_file_t or exceed the limits above.
 bool decode_recorded_file(const void* data, int size, RecordedFile* out, std::string* error);
 
+// The recording_end_t a recorder writes last when it closes cleanly.
+struct RecordingEnd {
+  TimeNs end_ns = 0;             // the last event's time before it
+  std::int64_t events = 0;       // events in the log before it
+  std::int64_t lost_events = 0;  // events the recorder could not write
+};
+std::vector<std::uint8_t> encode_recording_end(const RecordingEnd& end);
+// Fails on bytes that are not a recording_end_t or hold impossible counts.
+bool decode_recording_end(const void* data, int size, RecordingEnd* out, std::string* error);
+
 struct LoopTick {
   TimeNs time_ns = 0;
   std::int64_t seq = 0;
@@ -179,7 +191,9 @@ struct HalRecording {
   std::vector<LoopTick> ticks;
   std::vector<RecordedOutput> outputs;
   std::int64_t events = 0;         // log events loaded
-  bool truncated = false;          // the log ends mid-event (loaded with allow_truncated)
+  // The log ends mid-event or without its end record: the recorder was
+  // killed or lost power (loaded with allow_truncated).
+  bool truncated = false;
   std::int64_t lost_events = 0;    // bus events and video calls the recorder had no room for
   std::int64_t lost_frames = 0;    // camera frames among them
   std::int64_t missing_ticks = 0;  // gaps in the tick sequence
@@ -187,15 +201,18 @@ struct HalRecording {
 };
 
 struct HalRecordingOptions {
-  // Keep the complete events of a log that ends mid-event (a killed recorder).
+  // Keep the complete events of a log that ends mid-event or without its
+  // end record (a killed recorder, a power loss).
   bool allow_truncated = false;
 };
 
 // Reads the whole log from an open reader. False with one error naming the
 // file, the event number and channel, and the likely fix when: the first
 // event is not a recording_info_t (not a recording), its format version is
-// not kHalRecordFormatVersion, the log is truncated (unless allowed), an
-// event cannot be decoded, or the log is corrupt.
+// not kHalRecordFormatVersion, the log is truncated or lacks its end record
+// (unless allowed), an event cannot be decoded, an event follows the end
+// record, the end record's count differs from the events read, or the log is
+// corrupt.
 // A stream whose recorder lost events (ring overflow) is loaded up to the
 // hole; its end-of-stream report says so.
 bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& options, HalRecording* out,

@@ -60,11 +60,7 @@ DecodeResult decode_bytes(Msg& msg, const void* data, int size, int leading_stri
     // must never take the LCM thread down.
     return DecodeResult::kMalformed;
   }
-  // utime * 1000 must not overflow int64 (it would be undefined behaviour).
-  constexpr std::int64_t kMaxUtime = std::numeric_limits<std::int64_t>::max() / kNsPerUs;
-  if (msg.header.utime > kMaxUtime || msg.header.utime < -kMaxUtime) {
-    return DecodeResult::kMalformed;
-  }
+  if (!utime_in_range(msg.header.utime)) return DecodeResult::kMalformed;
   return DecodeResult::kOk;
 }
 

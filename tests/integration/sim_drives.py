@@ -396,6 +396,31 @@ def check_bad_recordings(tmp):
     p = replay(plain)
     if p.returncode != 2 or "--config" not in p.stderr:
         sys.exit(f"FAIL: a plain log without --config: exit {p.returncode}\n{p.stderr}")
+    # Cut exactly between two events (a power loss after a flush of whole
+    # events): only the missing end record tells.
+    events = lcm_log.read_events(log)
+    if events[-1].channel != "rtfuse/rec/end":
+        sys.exit(f"FAIL: the recording's last event is on {events[-1].channel}, not rtfuse/rec/end")
+    boundary = os.path.join(tmp, "boundary.lcm")
+    with lcm_log.LogWriter(boundary) as w:
+        for ev in events[: len(events) // 2]:
+            w.write(ev.channel, ev.data, ev.timestamp)
+    p = replay(boundary)
+    print(p.stderr.strip())
+    if p.returncode != 1 or "no rtfuse/rec/end record" not in p.stderr or "--allow-truncated" not in p.stderr:
+        sys.exit(f"FAIL: a recording cut between two events: exit {p.returncode}\n{p.stderr}")
+    if replay(boundary, "--allow-truncated").returncode != 0:
+        sys.exit("FAIL: a recording cut between two events, --allow-truncated")
+    # Not a log at all: the reader's own words, not "give --config".
+    tiny = os.path.join(tmp, "tiny.lcm")
+    with open(tiny, "wb") as g:
+        g.write(b"\xed\xa1\xda")
+    for path, words in ((os.path.join(tmp, "missing.lcm"), "No such file or directory"),
+                        (tmp, "is a directory"), (tiny, "truncated")):
+        p = replay(path)
+        print(p.stderr.strip())
+        if p.returncode != 1 or words not in p.stderr or "--config" in p.stderr:
+            sys.exit(f"FAIL: {path}: exit {p.returncode}, expected 1 and '{words}'\n{p.stderr}")
 
 
 IMU_ONLY_LINUX = """

@@ -110,13 +110,14 @@ TEST(Recorder, WritesALogTheLoaderReadsBackIdentically) {
   }
   ASSERT_TRUE(rec->stop(&err)) << err;
   const RecorderStats stats = rec->stats();
-  EXPECT_EQ(stats.events_written, 1 + 300 + 300 + 300 + 30);
+  EXPECT_EQ(stats.events_written, 1 + 300 + 300 + 300 + 30 + 1);  // info ... end record
   EXPECT_EQ(stats.write_errors, 0);
   EXPECT_EQ(stats.encode_errors, 0);
   EXPECT_EQ(stats.bus_events_lost, (std::vector<std::int64_t>{0, 0}));
 
   HalRecording loaded;
   ASSERT_TRUE(load(log.path(), &loaded, &err)) << err;
+  EXPECT_FALSE(loaded.truncated) << "stop() ends the log with its end record";
   EXPECT_EQ(loaded.info.config_text, "[loop]\nrate_hz = 200\n");
   EXPECT_EQ(loaded.info.config_hash, transport::config_text_hash("[loop]\nrate_hz = 200\n"));
   EXPECT_GT(loaded.info.start_ns, 0);
@@ -169,7 +170,7 @@ TEST(Recorder, ProducerCallsDoNotAllocateAndFullRingsAreCounted) {
   // Never started: stop() still writes what was queued.
   ASSERT_TRUE(rec->stop(&err)) << err;
   s = rec->stats();
-  EXPECT_EQ(s.events_written, 1 + 4 + 2);
+  EXPECT_EQ(s.events_written, 1 + 4 + 2 + 1);  // info, ticks, outputs, end record
   HalRecording loaded;
   ASSERT_TRUE(load(log.path(), &loaded, &err)) << err;
   EXPECT_EQ(loaded.ticks.size(), 4u);
@@ -231,7 +232,8 @@ TEST(Recorder, ACutFileLoadsOnlyWithAllowTruncated) {
     std::ifstream in(log.path(), std::ios::binary);
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
-  // Events 0 (info) .. 10 (the last clock read); cut inside the last one.
+  // Events 0 (info) .. 10 (the last clock read), 11 the end record; cut
+  // inside the end record.
   bytes.resize(bytes.size() - 5);
   {
     std::ofstream out(log.path(), std::ios::binary | std::ios::trunc);
@@ -239,14 +241,14 @@ TEST(Recorder, ACutFileLoadsOnlyWithAllowTruncated) {
   }
   HalRecording loaded;
   EXPECT_FALSE(load(log.path(), &loaded, &err));
-  EXPECT_NE(err.find("truncated after event 9, the recorder was probably killed: replay the first 10 events with "
-                     "--allow-truncated"),
+  EXPECT_NE(err.find("truncated after event 10, the recorder was probably killed or lost power: replay the first 11 "
+                     "events with --allow-truncated"),
             std::string::npos)
       << err;
   ASSERT_TRUE(load(log.path(), &loaded, &err, true)) << err;
   EXPECT_TRUE(loaded.truncated);
-  EXPECT_EQ(loaded.streams[1]->size(), 9u);
-  EXPECT_EQ(loaded.streams[1]->event(8).clock_ns, 9);
+  EXPECT_EQ(loaded.streams[1]->size(), 10u);
+  EXPECT_EQ(loaded.streams[1]->event(9).clock_ns, 10);
 }
 
 TEST(Recorder, ALostEventShowsAsAHoleInTheLoadedStream) {

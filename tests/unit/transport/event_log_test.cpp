@@ -308,6 +308,30 @@ TEST(EventLog, UnreadableFileNamesTheCause) {
   EXPECT_EQ(err, "cannot open log file " + path + ": No such file or directory");
 }
 
+TEST(EventLog, ADirectoryIsRefusedAtOpen) {
+  EventLogReader r;
+  std::string err;
+  const std::string dir = testing::TempDir();
+  EXPECT_FALSE(r.open(dir, &err));
+  EXPECT_EQ(err, "cannot open log file " + dir + ": it is a directory (give the .lcm file in it)");
+}
+
+TEST(EventLog, AStampBeyondNanosecondsIsCorrupt) {
+  // Every consumer turns utime into int64 nanoseconds: 9.3e15 us would
+  // overflow (issue 11, defect 3).
+  TempLog log("stamp");
+  write_two_events(log.path());
+  auto bytes = read_file(log.path());
+  set_be32(&bytes, 35 + 12, 0x00210000u);  // event 1's stamp: 0x0021000000000014 us = 9.29e15
+  write_file(log.path(), bytes);
+  std::string err;
+  int events = 0;
+  EXPECT_EQ(drain(log.path(), &err, &events), ReadStatus::kError);
+  EXPECT_EQ(events, 1);
+  EXPECT_EQ(err, "file " + log.path() + ": event 1 at byte 35 has the timestamp 9288674231451668 us, beyond what "
+                                        "nanoseconds can hold (+-9223372036854775 us): the log is corrupt");
+}
+
 TEST(EventLog, WriterRejectsWhatTheReaderWouldRefuse) {
   TempLog log("writer_reject");
   EventLogWriter w;

@@ -2,6 +2,7 @@
 
 #include <gtest/gtest.h>
 
+#include "support/recording_end.hpp"
 #include "support/temp_file.hpp"
 #include <unistd.h>
 
@@ -309,7 +310,8 @@ TEST(HalRecordingInfo, ValidationNamesTheBadDevice) {
 
 // --- the loader -------------------------------------------------------------
 
-void write_recording(const std::string& path, const std::vector<BusEvent>& evs, bool with_info = true) {
+void write_recording(const std::string& path, const std::vector<BusEvent>& evs, bool with_info = true,
+                     bool with_end = true) {
   const RecordingInfo info = make_info();
   HalRecordCodec codec(info.devices);
   EventLogWriter w;
@@ -332,6 +334,9 @@ void write_recording(const std::string& path, const std::vector<BusEvent>& evs, 
   }
   const std::uint8_t out[3] = {1, 2, 3};
   ASSERT_TRUE(w.write(77, "rtfuse/odometry", out, sizeof out, &err));
+  if (with_end) {
+    ASSERT_TRUE(test::write_recording_end(w, 77, &err)) << err;
+  }
   ASSERT_TRUE(w.close(&err)) << err;
 }
 
@@ -378,7 +383,7 @@ TEST(HalRecordingLoader, SplitsEventsIntoStreamsTicksAndOutputs) {
   EXPECT_EQ(rec.outputs[0].utime, 77);
   EXPECT_EQ(rec.outputs[0].event_number, static_cast<std::int64_t>(1 + 2 * evs.size()));
   EXPECT_EQ(rec.outputs[0].bytes, (std::vector<std::uint8_t>{1, 2, 3}));
-  EXPECT_EQ(rec.events, static_cast<std::int64_t>(2 + 2 * evs.size()));
+  EXPECT_EQ(rec.events, static_cast<std::int64_t>(3 + 2 * evs.size()));  // info, events and ticks, output, end
   EXPECT_FALSE(rec.truncated);
   EXPECT_TRUE(rec.warnings.empty());
 }
@@ -406,7 +411,8 @@ TEST(HalRecordingLoader, AnotherFormatVersionIsRefusedWithTheFix) {
   HalRecording rec;
   EXPECT_FALSE(load(log.path(), &rec, &err));
   EXPECT_NE(err.find("event 0 on rtfuse/rec/info: recorded in HAL record format version 7, this rtfuse reads "
-                     "version 2: replay it with the rtfuse version that recorded it"),
+                     "version " + std::to_string(kHalRecordFormatVersion) +
+                     ": replay it with the rtfuse version that recorded it"),
             std::string::npos)
       << err;
 }
@@ -420,27 +426,173 @@ TEST(HalRecordingLoader, TruncatedLogNeedsAllowTruncated) {
     std::ifstream in(log.path(), std::ios::binary);
     bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
   }
-  bytes.resize(bytes.size() - 2);  // the output message loses its last bytes
+  bytes.resize(bytes.size() - 2);  // the end record loses its last bytes
   {
     std::ofstream out(log.path(), std::ios::binary | std::ios::trunc);
     out.write(bytes.data(), static_cast<std::streamsize>(bytes.size()));
   }
-  const std::int64_t complete = static_cast<std::int64_t>(1 + 2 * evs.size());
+  const std::int64_t complete = static_cast<std::int64_t>(2 + 2 * evs.size());
   HalRecording rec;
   std::string err;
   EXPECT_FALSE(load(log.path(), &rec, &err));
   EXPECT_NE(err.find("truncated after event " + std::to_string(complete - 1) +
-                     ", the recorder was probably killed: replay the first " + std::to_string(complete) +
-                     " events with --allow-truncated"),
+                     ", the recorder was probably killed or lost power: replay the first " +
+                     std::to_string(complete) + " events with --allow-truncated"),
             std::string::npos)
       << err;
 
   ASSERT_TRUE(load(log.path(), &rec, &err, true)) << err;
   EXPECT_TRUE(rec.truncated);
   EXPECT_EQ(rec.events, complete);
-  EXPECT_TRUE(rec.outputs.empty());
+  EXPECT_EQ(rec.outputs.size(), 1u);
   EXPECT_EQ(rec.ticks.size(), evs.size());
   ASSERT_EQ(rec.warnings.size(), 1u);
+}
+
+TEST(HalRecordingLoader, ALogCutBetweenTwoEventsNeedsAllowTruncated) {
+  // A power loss after the writer flushed whole events: nothing is torn,
+  // only the end record is missing.
+  TempLog log("boundary");
+  const std::vector<BusEvent> evs = canonical_kinds();
+  write_recording(log.path(), evs, true, false);
+  const std::int64_t complete = static_cast<std::int64_t>(2 + 2 * evs.size());
+  HalRecording rec;
+  std::string err;
+  EXPECT_FALSE(load(log.path(), &rec, &err));
+  EXPECT_NE(err.find("ends after event " + std::to_string(complete - 1) +
+                     ", the recorder was probably killed or lost power: replay the first " +
+                     std::to_string(complete) + " events with --allow-truncated (no rtfuse/rec/end record"),
+            std::string::npos)
+      << err;
+  ASSERT_TRUE(load(log.path(), &rec, &err, true)) << err;
+  EXPECT_TRUE(rec.truncated);
+  EXPECT_EQ(rec.events, complete);
+  EXPECT_EQ(rec.outputs.size(), 1u);
+  ASSERT_EQ(rec.warnings.size(), 1u);
+
+  write_recording(log.path(), evs);
+  ASSERT_TRUE(load(log.path(), &rec, &err)) << err;
+  EXPECT_FALSE(rec.truncated);
+  EXPECT_TRUE(rec.warnings.empty());
+}
+
+TEST(HalRecordingLoader, TheEndRecordMustBeLastAndCountTheEvents) {
+  TempLog log("end");
+  const RecordingInfo info = make_info();
+  const auto bytes = encode_recording_info(info);
+  const std::uint8_t out[3] = {1, 2, 3};
+  std::string err;
+  HalRecording rec;
+  {
+    EventLogWriter w;
+    ASSERT_TRUE(w.open(log.path(), &err)) << err;
+    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), bytes.data(), bytes.size(), &err));
+    ASSERT_TRUE(test::write_recording_end(w, 2, &err));
+    ASSERT_TRUE(w.write(3, "rtfuse/odometry", out, sizeof out, &err));
+    ASSERT_TRUE(w.close(&err));
+  }
+  EXPECT_FALSE(load(log.path(), &rec, &err, true));
+  EXPECT_NE(err.find("event 2 on channel rtfuse/odometry cannot be decoded: an event after the end of the "
+                     "recording"),
+            std::string::npos)
+      << err;
+  {
+    // An event removed from the middle: the end record counts it.
+    EventLogWriter w;
+    ASSERT_TRUE(w.open(log.path(), &err)) << err;
+    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), bytes.data(), bytes.size(), &err));
+    const auto end = encode_recording_end({2'000, 3, 0});
+    ASSERT_TRUE(w.write(2, std::string(kRecordingEndChannel), end.data(), end.size(), &err));
+    ASSERT_TRUE(w.close(&err));
+  }
+  EXPECT_FALSE(load(log.path(), &rec, &err, true));
+  EXPECT_NE(err.find("the end record counts 3 events before it, the log holds 1"), std::string::npos) << err;
+  RecordingEnd end;
+  const auto negative = encode_recording_end({2'000, 1, -4});
+  EXPECT_FALSE(decode_recording_end(negative.data(), static_cast<int>(negative.size()), &end, &err));
+  EXPECT_NE(err.find("impossible lost event count -4"), std::string::npos) << err;
+}
+
+// Writes the int32 at byte `at` of an encoded record (LCM is big-endian).
+void poke_i32(std::vector<std::uint8_t>& b, std::size_t at, std::uint32_t v) {
+  for (int i = 0; i < 4; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (24 - 8 * i));
+}
+
+TEST(HalRecordingInfo, ImpossibleStringLengthsAreRefusedBeforeDecoding) {
+  // lcm-gen's decoder copies len - 1 bytes for any length: 2^31 read 2 GiB
+  // past the record (issue 11, defect 1).
+  const std::vector<std::uint8_t> good = encode_recording_info(make_info());
+  RecordingInfo back;
+  std::string err;
+  const std::size_t version_at = 36;  // after the fixed fields and both counts
+  for (const std::uint32_t len : {0x80000000u, 0x7fffffffu, 0u, 0xffffffffu, 4096u}) {
+    std::vector<std::uint8_t> bad = good;
+    poke_i32(bad, version_at, len);
+    EXPECT_FALSE(decode_recording_info(bad.data(), static_cast<int>(bad.size()), &back, &err)) << len;
+    EXPECT_NE(err.find("malformed recording_info_t: a string length is out of range"), std::string::npos) << err;
+  }
+  // The last device name's length, the furthest string from the start.
+  std::size_t at = version_at;
+  const RecordingInfo info = make_info();
+  std::vector<std::string> strings = {info.rtfuse_version, info.config_path, info.config_text};
+  strings.insert(strings.end(), info.streams.begin(), info.streams.end());
+  for (std::size_t i = 0; i + 1 < info.devices.size(); ++i) strings.push_back(info.devices[i].name);
+  for (const std::string& str : strings) at += 4 + str.size() + 1;
+  std::vector<std::uint8_t> bad = good;
+  poke_i32(bad, at, 0x80000000u);
+  EXPECT_FALSE(decode_recording_info(bad.data(), static_cast<int>(bad.size()), &back, &err));
+  poke_i32(bad, at, static_cast<std::uint32_t>(info.devices.back().name.size() + 1));
+  EXPECT_TRUE(decode_recording_info(bad.data(), static_cast<int>(bad.size()), &back, &err)) << err;
+}
+
+TEST(HalRecordingInfo, AStartTimeBeyondNanosecondsIsRefused) {
+  RecordingInfo info = make_info();
+  std::vector<std::uint8_t> bytes = encode_recording_info(info);
+  for (int i = 0; i < 8; ++i) bytes[8 + static_cast<std::size_t>(i)] = i == 0 ? 0x7f : 0xff;  // utime INT64_MAX
+  RecordingInfo back;
+  std::string err;
+  EXPECT_FALSE(decode_recording_info(bytes.data(), static_cast<int>(bytes.size()), &back, &err));
+  EXPECT_NE(err.find("start time 9223372036854775807 us is beyond what nanoseconds can hold"), std::string::npos)
+      << err;
+}
+
+TEST(HalRecordingLoader, TickSeqsAtTheEdgesOfInt64AreNoOverflow) {
+  // A tick seq of INT64_MAX once overflowed last_seq + 1 (issue 11, defect
+  // 2); negative seqs are refused, huge gaps are counted.
+  HalRecordCodec codec(make_info().devices);
+  std::uint8_t buf[kMaxHalRecordSize];
+  const std::int64_t consumed[1] = {0};
+  LoopTick tick;
+  std::string err;
+  int n = codec.encode_tick(0, -1, consumed, 1, 0u, buf, sizeof buf);
+  EXPECT_FALSE(HalRecordCodec::decode_tick(buf, n, &tick, &err));
+  EXPECT_NE(err.find("negative tick seq -1"), std::string::npos) << err;
+
+  TempLog log("seq");
+  const auto bytes = encode_recording_info(make_info());
+  auto write_ticks = [&](std::initializer_list<std::int64_t> seqs) {
+    EventLogWriter w;
+    ASSERT_TRUE(w.open(log.path(), &err)) << err;
+    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), bytes.data(), bytes.size(), &err));
+    std::int64_t t = 2;
+    for (const std::int64_t seq : seqs) {
+      const int k = codec.encode_tick(t * 1000, seq, consumed, 1, 0u, buf, sizeof buf);
+      ASSERT_TRUE(w.write(t++, std::string(kLoopTickChannel), buf, static_cast<std::size_t>(k), &err));
+    }
+    ASSERT_TRUE(test::write_recording_end(w, t, &err));
+    ASSERT_TRUE(w.close(&err));
+  };
+  HalRecording rec;
+  write_ticks({0, INT64_MAX});
+  ASSERT_TRUE(load(log.path(), &rec, &err)) << err;
+  EXPECT_EQ(rec.missing_ticks, INT64_MAX - 1);
+  write_ticks({INT64_MAX, INT64_MAX});
+  EXPECT_FALSE(load(log.path(), &rec, &err));
+  EXPECT_NE(err.find("tick seq 9223372036854775807 after 9223372036854775807 goes backwards"), std::string::npos)
+      << err;
+  write_ticks({0, INT64_MAX / 2, INT64_MAX});
+  ASSERT_TRUE(load(log.path(), &rec, &err)) << err;
+  EXPECT_EQ(rec.missing_ticks, INT64_MAX - 2);
 }
 
 TEST(HalRecordingLoader, AnUndecodableEventIsNamed) {
@@ -576,6 +728,7 @@ TEST(HalRecordingLoader, CarriesTheRecordedFilesIntoTheInfo) {
   ASSERT_TRUE(w.open(log.path(), &err)) << err;
   ASSERT_TRUE(w.write(5'000'000, std::string(kRecordingInfoChannel), bytes.data(), bytes.size(), &err));
   ASSERT_TRUE(w.write(5'000'000, std::string(kRecordedFileChannel), file.data(), file.size(), &err));
+  ASSERT_TRUE(test::write_recording_end(w, 5'000'000, &err)) << err;
   ASSERT_TRUE(w.close(&err)) << err;
   ASSERT_TRUE(load(log.path(), &rec, &err)) << err;
   ASSERT_EQ(rec.info.files.size(), 1u);

@@ -6,6 +6,7 @@
 #include <string>
 #include <vector>
 
+#include "support/recording_end.hpp"
 #include "support/temp_file.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
@@ -175,6 +176,7 @@ TEST(HalVideoLoader, FramesLoadIntoTheCameraStream) {
     const std::vector<std::uint8_t> info = encode_recording_info(make_info());
     ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), info.data(), info.size(), &err));
     ASSERT_TRUE(w.write(2, "rtfuse/hal/cam0", buf.data(), static_cast<std::size_t>(size), &err));
+    ASSERT_TRUE(test::write_recording_end(w, 2, &err)) << err;
     ASSERT_TRUE(w.close(&err)) << err;
   }
   EventLogReader reader;
