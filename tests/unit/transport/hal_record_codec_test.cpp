@@ -653,8 +653,10 @@ namespace rtfuse::transport {
 namespace {
 
 RecordedFile calibration_file() {
-  return {"camera.calibration", "/etc/rtfuse/calibration/SN10000001.conf",
-          std::string("[LEFT_CAM_VGA]\nfx=350\n\0binary\xff", 36)};
+  // A NUL and a byte above 127 among the text; the length from the array
+  // itself (a hand-counted 36 read past its 30 bytes: found by ASan).
+  static constexpr char kText[] = "[LEFT_CAM_VGA]\nfx=350\n\0binary\xff";
+  return {"camera.calibration", "/etc/rtfuse/calibration/SN10000001.conf", std::string(kText, sizeof kText - 1)};
 }
 
 TEST(HalRecordedFile, RoundTripsEveryByte) {
