@@ -18,6 +18,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 #include <string>
 #include <vector>
 
@@ -30,6 +31,7 @@
 
 #include "apps/grey_png.hpp"
 #include "apps/kitti_sequence.hpp"
+#include "apps/trajectory_metrics.hpp"
 #include "vision/stereo_odometry.hpp"
 
 namespace {
@@ -184,8 +186,32 @@ double max_of(const std::vector<double>& v) {
   return v.empty() ? 0.0 : *std::max_element(v.begin(), v.end());
 }
 
+// Mean ratio of the translations' lengths (a's over b's), frames first..last.
+double scale_ratio(const std::vector<Eigen::Matrix4d>& a, const std::vector<Eigen::Matrix4d>& b, int first,
+                   int last) {
+  double sum = 0.0;
+  for (int k = first; k <= last; ++k) {
+    sum += a[static_cast<std::size_t>(k - 1)].topRightCorner<3, 1>().norm() /
+           b[static_cast<std::size_t>(k - 1)].topRightCorner<3, 1>().norm();
+  }
+  return sum / (last - first + 1);
+}
+
+// KITTI poses (camera k -> camera 0) of per-frame motions (x_cur = T x_prev).
+std::vector<Eigen::Matrix4d> poses_of(const std::vector<Eigen::Matrix4d>& motions) {
+  std::vector<Eigen::Matrix4d> poses{Eigen::Matrix4d::Identity()};
+  for (const Eigen::Matrix4d& m : motions) poses.push_back(poses.back() * m.inverse());
+  return poses;
+}
+
 class VoReference : public ::testing::Test {
  protected:
+  // In the XML report and on stdout: the figures docs/performance.md quotes.
+  void report(const char* name, double value) {
+    RecordProperty(name, std::to_string(value));
+    std::printf("%s = %.4f\n", name, value);
+  }
+
   void SetUp() override {
     ASSERT_TRUE(motions().ok) << motions().error;
     ASSERT_EQ(motions().vo.size(), 50u);
@@ -196,9 +222,9 @@ class VoReference : public ::testing::Test {
 // the same motion.
 TEST_F(VoReference, AgreesWithOpenCvStereoPnpOnEveryFrame) {
   const Differences d = differences(motions().vo, motions().opencv, 1, 50);
-  RecordProperty("rotation_median_deg", std::to_string(median(d.rotation_deg)));
-  RecordProperty("rotation_max_deg", std::to_string(max_of(d.rotation_deg)));
-  RecordProperty("translation_median_m", std::to_string(median(d.translation_m)));
+  report("vo_vs_opencv_rotation_median_deg", median(d.rotation_deg));
+  report("vo_vs_opencv_rotation_max_deg", max_of(d.rotation_deg));
+  report("vo_vs_opencv_translation_median_m", median(d.translation_m));
   EXPECT_LT(median(d.rotation_deg), 0.025) << "median rotation difference per frame";
   EXPECT_LT(max_of(d.rotation_deg), 0.06) << "largest rotation difference of a frame";
   EXPECT_LT(median(d.translation_m), 0.02) << "median translation difference per frame";
@@ -208,6 +234,19 @@ TEST_F(VoReference, AgreesWithOpenCvStereoPnpOnEveryFrame) {
 // frame, and accumulates little rotation against it.
 TEST_F(VoReference, FollowsTheGroundTruthWhereItIsMeasured) {
   const Differences d = differences(motions().vo, motions().truth, 12, 50);
+  const Differences o = differences(motions().opencv, motions().truth, 12, 50);
+  report("frames_12_50_vo_rotation_median_deg", median(d.rotation_deg));
+  report("frames_12_50_vo_rotation_max_deg", max_of(d.rotation_deg));
+  report("frames_12_50_vo_translation_median_m", median(d.translation_m));
+  report("frames_12_50_opencv_rotation_median_deg", median(o.rotation_deg));
+  report("frames_12_50_opencv_translation_median_m", median(o.translation_m));
+  // Both are longer than the ground truth: the data's scale, not the VO's.
+  const double vo_scale = scale_ratio(motions().vo, motions().truth, 12, 50);
+  const double cv_scale = scale_ratio(motions().opencv, motions().truth, 12, 50);
+  report("frames_12_50_vo_scale", vo_scale);
+  report("frames_12_50_opencv_scale", cv_scale);
+  EXPECT_GT(vo_scale, 1.0);
+  EXPECT_GT(cv_scale, vo_scale);
   EXPECT_LT(median(d.rotation_deg), 0.022);
   EXPECT_LT(max_of(d.rotation_deg), 0.07);
   EXPECT_LT(median(d.translation_m), 0.012);
@@ -216,6 +255,8 @@ TEST_F(VoReference, FollowsTheGroundTruthWhereItIsMeasured) {
     vo = motions().vo[static_cast<std::size_t>(k - 1)] * vo;
     truth = motions().truth[static_cast<std::size_t>(k - 1)] * truth;
   }
+  report("frames_12_50_vo_accumulated_rotation_deg",
+         angle_deg(vo.topLeftCorner<3, 3>().transpose() * truth.topLeftCorner<3, 3>()));
   EXPECT_LT(angle_deg(vo.topLeftCorner<3, 3>().transpose() * truth.topLeftCorner<3, 3>()), 0.16)
       << "rotation error accumulated over frames 12-50";
 }
@@ -239,12 +280,28 @@ TEST_F(VoReference, GroundTruthOfFramesOneToElevenIsAConstantTwistTheImagesDoNot
   const double vo_vs_truth = angle_deg(vo.topLeftCorner<3, 3>().transpose() * truth.topLeftCorner<3, 3>());
   const double ocv_vs_truth = angle_deg(ocv.topLeftCorner<3, 3>().transpose() * truth.topLeftCorner<3, 3>());
   const double vo_vs_ocv = angle_deg(vo.topLeftCorner<3, 3>().transpose() * ocv.topLeftCorner<3, 3>());
-  RecordProperty("vo_vs_truth_deg", std::to_string(vo_vs_truth));
-  RecordProperty("opencv_vs_truth_deg", std::to_string(ocv_vs_truth));
-  RecordProperty("vo_vs_opencv_deg", std::to_string(vo_vs_ocv));
+  report("frames_1_11_vo_vs_truth_deg", vo_vs_truth);
+  report("frames_1_11_opencv_vs_truth_deg", ocv_vs_truth);
+  report("frames_1_11_vo_vs_opencv_deg", vo_vs_ocv);
   EXPECT_GT(vo_vs_truth, 0.5);
   EXPECT_GT(ocv_vs_truth, 0.5);
   EXPECT_LT(vo_vs_ocv, 0.15);
+}
+
+// What the targets (0.5 %, 0.2 m, 0.8 deg on frames 0-50) ask: an
+// estimator equal to the ground truth from frame 12 on that moves as the
+// images show in frames 1-11 (the VO's motions there, which OpenCV's
+// confirm) still misses them.
+TEST_F(VoReference, ExactFromFrameTwelveTheTargetsAreStillMissed) {
+  std::vector<Eigen::Matrix4d> m = motions().truth;
+  for (int k = 1; k <= 11; ++k) m[static_cast<std::size_t>(k - 1)] = motions().vo[static_cast<std::size_t>(k - 1)];
+  std::vector<Eigen::Matrix4d> truth = poses_of(motions().truth);
+  const rtfuse::apps::TrajectoryErrors e = rtfuse::apps::compare_trajectories(poses_of(m), truth);
+  report("exact_after_11_final_error_pct", e.final_error_pct);
+  report("exact_after_11_ate_rmse_m", e.ate_rmse_m);
+  report("exact_after_11_final_rotation_error_deg", e.final_rotation_error_deg);
+  EXPECT_GT(e.final_error_pct, 0.5);
+  EXPECT_GT(e.ate_rmse_m, 0.2);
 }
 
 }  // namespace
