@@ -90,34 +90,12 @@ class Scanner {
       if (c == '\n' && !multi) return std::nullopt;  // toml++ reports it
       if (c == '\\' && quote == '"') {
         advance();
-        if (multi) {
-          if (auto h = after_backslash()) return h;
-        } else if (i_ < s_.size() && at(i_) != '\n') {
-          advance();  // the escaped character, a quote perhaps
-        }
+        // The escaped character (a quote perhaps) is skipped; a line-ending
+        // backslash's newline and blanks are plain text to this scan.
+        if (i_ < s_.size() && (multi || at(i_) != '\n')) advance();
         continue;
       }
       advance();
-    }
-    return std::nullopt;
-  }
-
-  // In a multi-line basic string, after a backslash: toml++ tests the next
-  // character for whitespace (a line-ending backslash), and after a
-  // line-ending one every character up to the next non-blank.
-  std::optional<TomlHazard> after_backslash() {
-    std::size_t k = i_;
-    while (at(k) == ' ' || at(k) == '\t') ++k;
-    if (at(k) != '\n' && !(at(k) == '\r' && at(k + 1) == '\n')) {
-      if (at(i_) >= 0x80) return hazard("a backslash before a non-ASCII character is no TOML escape");
-      if (i_ < s_.size()) advance();  // the escaped character, a quote perhaps
-      return std::nullopt;
-    }
-    while (at(i_) == ' ' || at(i_) == '\t' || at(i_) == '\r' || at(i_) == '\n') advance();
-    if (at(i_) >= 0x80) {
-      return hazard(
-          "a non-ASCII character right after a line-ending backslash, which this toml++ (3.3) cannot read: "
-          "start the line with an ASCII character, or write it as \\uXXXX");
     }
     return std::nullopt;
   }

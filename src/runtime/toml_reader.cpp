@@ -125,6 +125,11 @@ std::optional<toml::table> parse(std::string_view text, const std::string& sourc
     return toml::parse(text, std::string_view(source_name));
   } catch (const toml::parse_error& e) {
     diag.add(e.source(), "", one_line(e.description()));
+  } catch (const TomlInternalCheck& e) {
+    // toml++ gives no position here (runtime/toml.hpp).
+    diag.add(toml::source_region{}, "",
+             std::string("not valid TOML: the parser (toml++ 3.3) stopped on its internal check `") + e.what() +
+                 "` instead of naming the error; look for a stray bracket, brace, quote or comma");
   }
 #else
   toml::parse_result parsed = toml::parse(text, std::string_view(source_name));

@@ -15,7 +15,7 @@
 #include <utility>
 #include <vector>
 
-#include <toml++/toml.h>
+#include "runtime/toml.hpp"
 
 #include "estimation/state.hpp"
 #include "runtime/config.hpp"
