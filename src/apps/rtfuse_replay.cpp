@@ -74,7 +74,7 @@ LogKind classify_log(const std::string& path, std::string* error) {
 
 
 int replay_recording(const std::string& log_path, const std::string& config_path, const std::string& out_path,
-                     bool allow_truncated, bool tty) {
+                     bool allow_truncated, std::uint64_t frame_memory_mib, bool tty) {
   rtfuse::transport::EventLogReader in;
   std::string error;
   if (!in.open(log_path, &error)) {
@@ -84,6 +84,7 @@ int replay_recording(const std::string& log_path, const std::string& config_path
   rtfuse::transport::HalRecording rec;
   rtfuse::transport::HalRecordingOptions options;
   options.allow_truncated = allow_truncated;
+  options.max_frame_bytes = frame_memory_mib << 20;
   if (!rtfuse::transport::load_hal_recording(in, options, &rec, &error)) {
     std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
     return 1;
@@ -160,12 +161,17 @@ int main(int argc, char** argv) {
   std::string config_path, log_path, out_path;
   bool quiet = false;
   bool allow_truncated = false;
+  std::uint64_t frame_memory_mib = rtfuse::transport::HalRecordingOptions{}.max_frame_bytes >> 20;
   app.add_option("-c,--config", config_path,
                  "TOML config (required for an ordinary log; a HAL recording carries its own)");
   app.add_option("-l,--log", log_path, "input LCM log")->required();
   app.add_option("-o,--out", out_path, "write the published channels to this LCM log");
   app.add_flag("--allow-truncated", allow_truncated,
                "replay the complete part of a HAL recording whose recorder was killed");
+  app.add_option("--frame-memory", frame_memory_mib,
+                 "MiB a HAL recording's camera frames may take in memory (each padded to its buffer)")
+      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 24))
+      ->capture_default_str();
   app.add_flag("-q,--quiet", quiet, "no progress line");
   try {
     app.parse(argc, argv);
@@ -181,7 +187,9 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtfuse-replay: %s\n", why.c_str());
     return 1;
   }
-  if (kind == LogKind::kHalRecording) return replay_recording(log_path, config_path, out_path, allow_truncated, tty);
+  if (kind == LogKind::kHalRecording) {
+    return replay_recording(log_path, config_path, out_path, allow_truncated, frame_memory_mib, tty);
+  }
   // An empty log with --config replays nothing: how tools/deploy.sh has a
   // configuration checked by the loop that will run it.
   if (kind == LogKind::kEmpty && config_path.empty()) {

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <exception>
 #include <limits>
+#include <string_view>
 #include <utility>
 
 #include "rtfuse/hal_can_t.hpp"
@@ -15,6 +16,7 @@
 #include "rtfuse/recording_file_t.hpp"
 #include "rtfuse/recording_info_t.hpp"
 #include "transport/encode_buffer.hpp"
+#include "transport/lcm_wire.hpp"
 
 namespace rtfuse::transport {
 
@@ -23,54 +25,22 @@ using hal::BusEventKind;
 using hal::CanBusState;
 using hal::HalStatus;
 
+using wire::load_i32;
+using wire::load_i64;
+
 namespace {
 
 constexpr int kMaxStatus = static_cast<int>(HalStatus::kMalformed);
 constexpr int kMaxBusState = static_cast<int>(CanBusState::kBusOff);
 
-std::int32_t load_i32(const std::uint8_t* p) {
-  const std::uint32_t v = (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) |
-                          (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]};
-  return static_cast<std::int32_t>(v);
-}
-
-std::int64_t load_i64(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
-  return static_cast<std::int64_t>(v);
-}
-
 void set_error(std::string* error, std::string message) {
   if (error != nullptr) *error = std::move(message);
 }
 
-// lcm-gen's decode() sizes a vector from the count field before it checks
-// that the bytes are there, and turns a string length <= 0 into a throwing
-// assign: counts and the leading string are bounded here first, so a corrupt
-// record cannot make the loader reserve gigabytes.
-//
 // Every hal_* record starts with fingerprint, utime, time_ns, then the device
-// string. Offset just past that string, or -1.
+// string. Offset just past that string, or -1 (wire::after_string).
 int after_device_string(const std::uint8_t* b, int size) {
-  constexpr int kAt = 8 + 8 + 8;
-  if (size < kAt + 4) return -1;
-  const std::int32_t len = load_i32(b + kAt);
-  if (len < 1 || len > size - kAt - 4) return -1;
-  return kAt + 4 + len;
-}
-
-// n LCM strings from `at` (an int32 length counting the NUL, then the
-// bytes), each of 0..max_chars characters and all within the record:
-// the offset just past them, or -1. lcm-gen's decoder copies len - 1 bytes
-// for any length, so a length of 0 or 2^31 must never reach it.
-int after_strings(const std::uint8_t* b, int size, int at, int n, std::int64_t max_chars) {
-  for (int i = 0; i < n; ++i) {
-    if (at < 0 || size - at < 4) return -1;
-    const std::int32_t len = load_i32(b + at);
-    if (len < 1 || len - 1 > max_chars || len > size - at - 4) return -1;
-    at += 4 + len;
-  }
-  return at;
+  return wire::after_string(b, size, 8 + 8 + 8, std::numeric_limits<std::int32_t>::max());
 }
 
 bool count_within(const std::uint8_t* b, int size, int at, int max) {
@@ -150,7 +120,21 @@ std::int64_t config_text_hash(std::string_view text) noexcept {
 
 namespace {
 
+// LCM strings end at their first NUL (lcm-gen's encoder uses strlen()):
+// one inside would write a record its own reader refuses.
+bool without_nul(const std::string& s, const std::string& what, std::string* error) {
+  const std::size_t at = s.find('\0');
+  if (at == std::string::npos) return true;
+  set_error(error, "recording info: " + what + " has a NUL byte at offset " + std::to_string(at) +
+                       " (an LCM string cannot hold one)");
+  return false;
+}
+
 bool valid_file(const RecordedFile& f, std::string* error) {
+  if (!without_nul(f.key, "a recorded file's key", error) ||
+      !without_nul(f.path, "recorded file '" + f.key + "''s path", error)) {
+    return false;
+  }
   if (f.key.empty() || f.key.size() > kMaxRecordedFileKeyLength || f.path.size() > kMaxRecordedFilePathLength ||
       f.text.size() > kMaxRecordedFileBytes) {
     set_error(error, "recorded file '" + f.key.substr(0, kMaxRecordedFileKeyLength) + "': key of " +
@@ -167,6 +151,14 @@ bool valid_file(const RecordedFile& f, std::string* error) {
 }  // namespace
 
 bool validate(const RecordingInfo& info, std::string* error) {
+  if (!without_nul(info.rtfuse_version, "the rtfuse version", error) ||
+      !without_nul(info.config_path, "the configuration path", error) ||
+      !without_nul(info.config_text, "the configuration text", error)) {
+    return false;
+  }
+  for (const std::string& stream : info.streams) {
+    if (!without_nul(stream, "a stream name", error)) return false;
+  }
   const auto n_streams = static_cast<int>(info.streams.size());
   if (n_streams < 1 || n_streams > kMaxRecordedStreams) {
     set_error(error, "recording info: " + std::to_string(n_streams) + " streams (expected 1.." +
@@ -182,7 +174,7 @@ bool validate(const RecordingInfo& info, std::string* error) {
     const RecordedDevice& d = info.devices[i];
     const std::string where = "recording info: device " + std::to_string(i) + " '" + d.name + "'";
     if (d.name.empty() || d.name.size() > kMaxDeviceNameLength ||
-        d.name.find_first_of("/ \t\n") != std::string::npos) {
+        d.name.find_first_of(std::string_view("/ \t\n\0", 5)) != std::string::npos) {
       set_error(error, where + ": a device name is 1.." + std::to_string(kMaxDeviceNameLength) +
                            " characters without '/' or spaces (it becomes the channel rtfuse/hal/<name>)");
       return false;
@@ -270,9 +262,10 @@ bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::
   // Then every string: version, config path and text, the stream and device
   // names (counts bounded just above).
   constexpr int kStringsAt = 36;
-  if (after_strings(b, size, kStringsAt, 3 + load_i32(b + 28) + load_i32(b + 32), size) < 0) {
-    set_error(error, "malformed recording_info_t: a string length is out of range or past the record's " +
-                         std::to_string(size) + " bytes");
+  if (wire::after_strings(b, size, kStringsAt, 3 + load_i32(b + 28) + load_i32(b + 32), size) < 0) {
+    set_error(error,
+              "malformed recording_info_t: a string has a NUL inside it, or a length out of range or past the record's " +
+                  std::to_string(size) + " bytes");
     return false;
   }
   rtfuse::recording_info_t m;
@@ -339,13 +332,13 @@ bool decode_recording_end(const void* data, int size, RecordingEnd* out, std::st
 bool decode_recorded_file(const void* data, int size, RecordedFile* out, std::string* error) {
   const auto* b = static_cast<const std::uint8_t*>(data);
   // Both strings and the byte count bounded before lcm-gen's decoder sizes
-  // anything from them (see after_device_string).
+  // anything from them (transport/lcm_wire.hpp).
   int at = 8;
   for (const std::size_t max : {kMaxRecordedFileKeyLength, kMaxRecordedFilePathLength}) {
-    const int next = b == nullptr ? -1 : after_strings(b, size, at, 1, static_cast<std::int64_t>(max));
+    const int next = wire::after_string(b, size, at, static_cast<std::int64_t>(max));
     if (next < 0) {
       set_error(error, "malformed recording_file_t: the string at byte " + std::to_string(at) +
-                           " has an impossible length");
+                           " has an impossible length or a NUL inside it");
       return false;
     }
     at = next;
@@ -869,6 +862,7 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
     return false;
   };
 
+  std::uint64_t frame_bytes = 0;  // ReplayVideoLog's, all streams
   bool ended = false;
   // A log cut short: mid-event, or between two events without the end
   // record. Allowed, its complete events are kept.
@@ -930,6 +924,20 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
                                " before event " + std::to_string(ev.event_number) +
                                " (its ring was full): this stream replays only up to there");
         continue;
+      }
+      if (video.has_frame()) {
+        const std::uint64_t need = std::max<std::uint64_t>(video.data_size, video.length);
+        frame_bytes += need;
+        if (frame_bytes > options.max_frame_bytes) {
+          set_error(error, "file " + path + ": event " + std::to_string(ev.event_number) + " on channel " +
+                               std::string(ev.channel) + ": the camera frames up to here need " +
+                               std::to_string(frame_bytes >> 20) + " MiB in memory (this one a buffer of " +
+                               std::to_string(video.length) + " bytes), more than the " +
+                               std::to_string(options.max_frame_bytes >> 20) +
+                               " MiB allowed: a corrupt buffer length, or a recording to replay with a larger "
+                               "--frame-memory on a machine that has it");
+          return false;
+        }
       }
       log.append(video, frame, ev.event_number);
     } else if (starts_with(ev.channel, kHalChannelPrefix)) {

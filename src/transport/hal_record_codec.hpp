@@ -204,6 +204,12 @@ struct HalRecordingOptions {
   // Keep the complete events of a log that ends mid-event or without its
   // end record (a killed recorder, a power loss).
   bool allow_truncated = false;
+  // Camera frames are held in memory for the replay, each padded to its
+  // buffer's capacity as the driver saw it. A recording whose frames need
+  // more is refused with the figure (rtfuse-replay --frame-memory) rather
+  // than left to the OOM killer: a corrupt buffer length in a few bytes of
+  // log could otherwise ask for gigabytes.
+  std::uint64_t max_frame_bytes = std::uint64_t{4} << 30;
 };
 
 // Reads the whole log from an open reader. False with one error naming the

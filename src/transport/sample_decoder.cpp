@@ -9,6 +9,8 @@
 #include <limits>
 #include <string_view>
 
+#include "transport/lcm_wire.hpp"
+
 namespace rtfuse::transport {
 namespace {
 
@@ -18,40 +20,20 @@ constexpr double kQuaternionNormTolerance = 0.01;
 constexpr double kMinQuaternionNorm = 1e-6;
 constexpr double kSymmetryTolerance = 1e-6;
 
-std::int64_t load_i64(const std::uint8_t* p) {
-  std::uint64_t v = 0;
-  for (int i = 0; i < 8; ++i) v = (v << 8) | p[i];
-  return static_cast<std::int64_t>(v);
-}
-
-std::int32_t load_i32(const std::uint8_t* p) {
-  const std::uint32_t v = (std::uint32_t{p[0]} << 24) | (std::uint32_t{p[1]} << 16) |
-                          (std::uint32_t{p[2]} << 8) | std::uint32_t{p[3]};
-  return static_cast<std::int32_t>(v);
-}
-
-// lcm-gen's decode() turns a string length of 0 or less into a huge
-// std::string::assign (which throws), so the lengths are checked first. Every
-// input type starts with its fingerprint and a header_t (utime, seq,
+// Every input type starts with its fingerprint and a header_t (utime, seq,
 // frame_id); odometry_t follows it with child_frame_id: `strings` is how many
-// of those leading strings there are.
+// of those leading strings there are, checked before lcm-gen's decoder sees
+// them (transport/lcm_wire.hpp).
 bool leading_strings_sane(const std::uint8_t* bytes, int size, int strings) {
-  int pos = 8 + 8 + 4;  // fingerprint, header.utime, header.seq
-  for (int i = 0; i < strings; ++i) {
-    if (size - pos < 4) return false;
-    const std::int32_t len = load_i32(bytes + pos);
-    pos += 4;
-    if (len < 1 || len > size - pos) return false;
-    pos += len;
-  }
-  return true;
+  constexpr int kFirstStringAt = 8 + 8 + 4;  // fingerprint, header.utime, header.seq
+  return wire::after_strings(bytes, size, kFirstStringAt, strings, std::numeric_limits<std::int32_t>::max()) >= 0;
 }
 
 template <class Msg>
 DecodeResult decode_bytes(Msg& msg, const void* data, int size, int leading_strings) {
   if (data == nullptr || size < 8) return DecodeResult::kMalformed;
   const auto* bytes = static_cast<const std::uint8_t*>(data);
-  if (load_i64(bytes) != Msg::getHash()) return DecodeResult::kWrongType;
+  if (wire::load_i64(bytes) != Msg::getHash()) return DecodeResult::kWrongType;
   if (!leading_strings_sane(bytes, size, leading_strings)) return DecodeResult::kMalformed;
   try {
     if (msg.decode(data, 0, size) < 0) return DecodeResult::kMalformed;
@@ -108,8 +90,10 @@ DecodeResult check_quaternion(const rtfuse::quaternion_t& q) {
   if (!(std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::isfinite(q.w))) {
     return DecodeResult::kNonFinite;
   }
+  // A norm that overflows (components beyond ~1e154) would normalise to a
+  // zero quaternion: no orientation to recover, like one of norm zero.
   const double norm = std::sqrt(q.x * q.x + q.y * q.y + q.z * q.z + q.w * q.w);
-  return norm < kMinQuaternionNorm ? DecodeResult::kNonFinite : DecodeResult::kOk;
+  return norm >= kMinQuaternionNorm && std::isfinite(norm) ? DecodeResult::kOk : DecodeResult::kNonFinite;
 }
 
 // Call after check_quaternion(). Like robot_localization, a quaternion close

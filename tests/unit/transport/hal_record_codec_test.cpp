@@ -529,7 +529,7 @@ TEST(HalRecordingInfo, ImpossibleStringLengthsAreRefusedBeforeDecoding) {
     std::vector<std::uint8_t> bad = good;
     poke_i32(bad, version_at, len);
     EXPECT_FALSE(decode_recording_info(bad.data(), static_cast<int>(bad.size()), &back, &err)) << len;
-    EXPECT_NE(err.find("malformed recording_info_t: a string length is out of range"), std::string::npos) << err;
+    EXPECT_NE(err.find("malformed recording_info_t: a string"), std::string::npos) << err;
   }
   // The last device name's length, the furthest string from the start.
   std::size_t at = version_at;
@@ -690,6 +690,32 @@ TEST(HalRecordedFile, CorruptLengthsAreRefusedBeforeDecoding) {
   }
   EXPECT_FALSE(decode_recorded_file(good.data(), static_cast<int>(good.size()) - 1, &out, &err));
   EXPECT_FALSE(decode_recorded_file(good.data(), 6, &out, &err));
+}
+
+TEST(HalRecordedFile, AStringWithANulInsideIsRefused) {
+  // The fuzzer's finding: a path with NULs inside decoded, but lcm-gen's
+  // encoder measures strings with strlen(), so the record written back from
+  // it announced more bytes than it held and was refused as "8 trailing bytes".
+  const std::vector<std::uint8_t> good = encode_recorded_file(calibration_file());
+  const std::size_t path_at = 8 + 4 + calibration_file().key.size() + 1 + 4;
+  std::vector<std::uint8_t> bad = good;
+  bad[path_at + 1] = 0;
+  RecordedFile out;
+  std::string err;
+  EXPECT_FALSE(decode_recorded_file(bad.data(), static_cast<int>(bad.size()), &out, &err));
+  EXPECT_NE(err.find("NUL inside"), std::string::npos) << err;
+  bad = good;
+  bad[path_at + calibration_file().path.size()] = '/';  // no terminating NUL
+  EXPECT_FALSE(decode_recorded_file(bad.data(), static_cast<int>(bad.size()), &out, &err));
+
+  RecordingInfo info = make_info();
+  info.config_text = std::string("a = 1\0b = 2", 11);
+  EXPECT_FALSE(validate(info, &err));
+  EXPECT_NE(err.find("configuration text has a NUL byte at offset 5"), std::string::npos) << err;
+  // What the recorder would have written from it: unreadable.
+  const std::vector<std::uint8_t> bytes = encode_recording_info(info);
+  RecordingInfo back;
+  EXPECT_FALSE(decode_recording_info(bytes.data(), static_cast<int>(bytes.size()), &back, &err));
 }
 
 TEST(HalRecordedFile, LimitsAndDuplicatesAreRefused) {

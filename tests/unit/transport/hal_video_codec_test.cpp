@@ -193,5 +193,45 @@ TEST(HalVideoLoader, FramesLoadIntoTheCameraStream) {
   EXPECT_EQ(data[315], 0);
 }
 
+TEST(HalVideoLoader, FramesBeyondTheMemoryAllowedAreRefusedBeforeTheyAreHeld) {
+  // The fuzzer's out-of-memory: each frame record of a few bytes claiming a
+  // 4 GiB buffer, padded in memory to it. The loader counts what the frames
+  // will take and stops at the limit with the figure.
+  test::TempFile file("video_memory", ".lcm");
+  HalRecordCodec codec(make_info().devices);
+  const std::vector<std::uint8_t> frame = pattern(64);
+  std::vector<std::uint8_t> buf(64 + kVideoRecordOverhead);
+  VideoEvent ev = dequeue_event(64);
+  ev.length = 3u << 20;  // a 3 MiB buffer holding 64 bytes, as an MJPEG frame may
+  const int size = codec.encode_video(ev, frame.data(), buf.data(), static_cast<int>(buf.size()));
+  ASSERT_GT(size, 0);
+  std::string err;
+  {
+    EventLogWriter w;
+    ASSERT_TRUE(w.open(file.path(), &err)) << err;
+    const std::vector<std::uint8_t> info = encode_recording_info(make_info());
+    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), info.data(), info.size(), &err));
+    for (int i = 0; i < 3; ++i) {
+      ASSERT_TRUE(w.write(2 + i, "rtfuse/hal/cam0", buf.data(), static_cast<std::size_t>(size), &err));
+    }
+    ASSERT_TRUE(test::write_recording_end(w, 4, &err)) << err;
+    ASSERT_TRUE(w.close(&err)) << err;
+  }
+  HalRecordingOptions options;
+  options.max_frame_bytes = 8u << 20;  // two frames fit, the third does not
+  EventLogReader reader;
+  ASSERT_TRUE(reader.open(file.path(), &err)) << err;
+  HalRecording rec;
+  EXPECT_FALSE(load_hal_recording(reader, options, &rec, &err));
+  EXPECT_NE(err.find("event 3 on channel rtfuse/hal/cam0: the camera frames up to here need 9 MiB in memory (this one "
+                     "a buffer of 3145728 bytes), more than the 8 MiB allowed"),
+            std::string::npos)
+      << err;
+  options.max_frame_bytes = 9u << 20;
+  ASSERT_TRUE(reader.open(file.path(), &err)) << err;
+  HalRecording enough;
+  EXPECT_TRUE(load_hal_recording(reader, options, &enough, &err)) << err;
+}
+
 }  // namespace
 }  // namespace rtfuse::transport

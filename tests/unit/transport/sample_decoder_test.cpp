@@ -228,6 +228,36 @@ TEST_F(SampleDecoderTest, ZeroQuaternionIsRejectedAndOffNormIsNormalised) {
   EXPECT_EQ(out_.pose.orientation.w(), 1.005);
 }
 
+TEST_F(SampleDecoderTest, AQuaternionWhoseNormOverflowsIsRejectedNotZeroed) {
+  // The fuzzer's finding: finite components whose squares overflow made a
+  // norm of infinity, and normalising by it gave the zero quaternion.
+  auto p = good_pose();
+  p.pose.pose.orientation = {0.0, 0.0, 1e200, 1.0};
+  EXPECT_EQ(decode(SensorKind::kPose, p), DecodeResult::kNonFinite);
+  auto i = good_imu();
+  i.orientation = {-1e160, 0.0, 0.0, 0.0};
+  EXPECT_EQ(decode(SensorKind::kImu, i), DecodeResult::kNonFinite);
+  // Large but representable: normalised.
+  p.pose.pose.orientation = {0.0, 0.0, 0.0, 1e150};
+  ASSERT_EQ(decode(SensorKind::kPose, p), DecodeResult::kOk);
+  EXPECT_DOUBLE_EQ(out_.pose.orientation.w(), 1.0);
+}
+
+TEST_F(SampleDecoderTest, AFrameNameWithANulInsideIsMalformed) {
+  // lcm-gen's decoder keeps what follows a NUL and its encoder drops it: such
+  // a name is no string a sender meant, and no frame.
+  auto b = bytes_of(good_twist());
+  // header.frame_id ("base_link" or similar) starts after its 4-byte length at 24.
+  b[25] = 0;
+  EXPECT_EQ(decoder_.decode(SensorKind::kTwist, b.data(), static_cast<int>(b.size()), &out_),
+            DecodeResult::kMalformed);
+  b = bytes_of(good_twist());
+  const std::int32_t len = (b[20] << 24) | (b[21] << 16) | (b[22] << 8) | b[23];
+  b[24 + static_cast<std::size_t>(len) - 1] = 'x';  // the terminating NUL overwritten
+  EXPECT_EQ(decoder_.decode(SensorKind::kTwist, b.data(), static_cast<int>(b.size()), &out_),
+            DecodeResult::kMalformed);
+}
+
 TEST_F(SampleDecoderTest, BadCovariances) {
   auto p = good_pose();
   p.pose.covariance[1] += 0.5;  // (0,1) != (1,0)
