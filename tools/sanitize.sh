@@ -1,8 +1,10 @@
 #!/usr/bin/env bash
 # sanitize.sh asan|tsan [test args...]: build a sanitizer tree under build/
 # and run what it checks (issue 11):
-#   asan  AddressSanitizer + UndefinedBehaviorSanitizer (-O1 -g1, no recovery:
-#         any finding fails its test): the unit and integration tests.
+#   asan  AddressSanitizer + UndefinedBehaviorSanitizer (clang, -O1 -g1, no
+#         recovery: any finding fails its test): the unit and integration
+#         tests, in the tree that also holds the fuzz harnesses
+#         (tools/asan_tree.sh, tools/fuzz.sh).
 #   tsan  ThreadSanitizer: the core and runtime unit tests (rings, seqlock,
 #         frame pool, recorder, devices) and rtfused live on the simulated
 #         robot with every sensor (encoders, IMU, camera with visual
@@ -14,19 +16,21 @@ kind=${1:-}
 shift || true
 "$root/tools/setup-deps.sh"
 
-configure() {  # dir sanitizers
+configure_tsan() {  # dir
   if [[ ! -f "$1/build.ninja" ]]; then
     cmake -S "$root" -B "$1" -G Ninja -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O1 -g1" \
       -DRTFUSE_BUILD_TESTS=ON -DRTFUSE_BUILD_BENCH=OFF -DRTFUSE_WERROR=ON -DRTFUSE_EIGEN_NO_MALLOC_CHECK=ON \
-      -DRTFUSE_SANITIZE="$2" >/dev/null
+      -DRTFUSE_SANITIZE=thread >/dev/null
   fi
 }
 
 supp="$root/tests/sanitizers"
 case "$kind" in
   asan)
-    dir="$root/build/asan"
-    configure "$dir" address,undefined
+    # shellcheck source=asan_tree.sh
+    source "$root/tools/asan_tree.sh"
+    configure_asan_tree
+    dir="$asan_tree"
     cmake --build "$dir" -j"$(nproc)"
     export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1"
     export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
@@ -35,7 +39,7 @@ case "$kind" in
     ;;
   tsan)
     dir="$root/build/tsan"
-    configure "$dir" thread
+    configure_tsan "$dir"
     cmake --build "$dir" -j"$(nproc)" --target rtfuse_unit_core rtfuse_unit_runtime rtfused
     export TSAN_OPTIONS="suppressions=$supp/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
     "$dir/tests/rtfuse_unit_core" "$@"

@@ -31,6 +31,10 @@ packages=(
   # the kernel system test (tests/kernel) boots Debian's own kernel under
   # qemu with a busybox initramfs and runs the Linux backends on its drivers
   qemu-system-x86 busybox-static cpio kmod
+  # the AddressSanitizer tree and the fuzz harnesses (tools/asan_tree.sh,
+  # tools/fuzz.sh): clang, its sanitizer and libFuzzer runtimes, and
+  # llvm-symbolizer for the stack traces of a finding
+  clang libclang-rt-dev llvm
   # the stereo rectification's reference in the test build (tests/reference);
   # never linked into the runtime
   libopencv-dev

@@ -2,7 +2,9 @@
 # Quick start, tests: install what is missing, build the test tree, run every
 # test (unit, integration, system, tools, package, deploy) with CTest; then
 # the sanitizer stage (tools/sanitize.sh: ASan+UBSan over the unit and
-# integration tests, TSan over the core and runtime tests and the daemon);
+# integration tests, TSan over the core and runtime tests and the daemon),
+# with the fuzz regression (tools/fuzz.sh --regression: every harness
+# replays its seeds and past findings and fuzzes briefly);
 # then the aarch64 stage (tools/test-cross.sh): cross build, tests under
 # qemu, the arm64 package in a clean arm64 root, the target-ABI check.
 # CTest arguments are passed to the CTest stages (e.g. -R replay).
@@ -15,6 +17,7 @@ root=$(cd "$(dirname "$0")/.." && pwd)
 (cd "$root/build/test" && ctest --output-on-failure -j2 "$@")
 if [[ "${RTFUSE_SANITIZERS:-1}" != 0 ]]; then
   "$root/tools/sanitize.sh" asan "$@"
+  "$root/tools/fuzz.sh" --regression
   "$root/tools/sanitize.sh" tsan
 fi
 if [[ "${RTFUSE_CROSS:-1}" != 0 ]]; then
