@@ -49,6 +49,25 @@ std::vector<std::uint8_t> pattern(std::size_t n) {
   return v;
 }
 
+// A recording of make_info() whose events after the info are these camera
+// records, closed by its end record unless `cut`.
+void write_camera_recording(const std::string& path, const std::vector<std::vector<std::uint8_t>>& records,
+                            bool cut = false) {
+  std::string err;
+  EventLogWriter w;
+  ASSERT_TRUE(w.open(path, &err)) << err;
+  const std::vector<std::uint8_t> info = encode_recording_info(make_info());
+  ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), info.data(), info.size(), &err));
+  for (std::size_t i = 0; i < records.size(); ++i) {
+    const auto stamp = 2 + static_cast<std::int64_t>(i);
+    ASSERT_TRUE(w.write(stamp, "rtfuse/hal/cam0", records[i].data(), records[i].size(), &err)) << err;
+  }
+  if (!cut) {
+    ASSERT_TRUE(test::write_recording_end(w, static_cast<std::int64_t>(records.size()) + 1, &err)) << err;
+  }
+  ASSERT_TRUE(w.close(&err)) << err;
+}
+
 TEST(HalVideoCodec, AFrameRoundTripsByteForByte) {
   HalRecordCodec codec(make_info().devices);
   const std::size_t n = 1344 * 376 * 2;
@@ -142,17 +161,10 @@ TEST(HalVideoLoader, ACorruptFrameRecordNamesTheLogEvent) {
   std::vector<std::uint8_t> buf(256 + kVideoRecordOverhead);
   const int size = codec.encode_video(dequeue_event(256), frame.data(), buf.data(), static_cast<int>(buf.size()));
   ASSERT_GT(size, 0);
+  // The same record cut short, as a complete log event.
+  const auto whole = buf.begin() + size;
+  write_camera_recording(file.path(), {{buf.begin(), whole}, {buf.begin(), whole - 100}}, true);
   std::string err;
-  {
-    EventLogWriter w;
-    ASSERT_TRUE(w.open(file.path(), &err)) << err;
-    const std::vector<std::uint8_t> info = encode_recording_info(make_info());
-    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), info.data(), info.size(), &err));
-    ASSERT_TRUE(w.write(2, "rtfuse/hal/cam0", buf.data(), static_cast<std::size_t>(size), &err));
-    // The same record cut short, as a complete log event.
-    ASSERT_TRUE(w.write(3, "rtfuse/hal/cam0", buf.data(), static_cast<std::size_t>(size - 100), &err));
-    ASSERT_TRUE(w.close(&err)) << err;
-  }
   EventLogReader reader;
   ASSERT_TRUE(reader.open(file.path(), &err)) << err;
   HalRecording rec;
@@ -169,16 +181,8 @@ TEST(HalVideoLoader, FramesLoadIntoTheCameraStream) {
   std::vector<std::uint8_t> buf(300 + kVideoRecordOverhead);
   VideoEvent ev = dequeue_event(300);
   const int size = codec.encode_video(ev, frame.data(), buf.data(), static_cast<int>(buf.size()));
+  write_camera_recording(file.path(), {{buf.begin(), buf.begin() + size}});
   std::string err;
-  {
-    EventLogWriter w;
-    ASSERT_TRUE(w.open(file.path(), &err)) << err;
-    const std::vector<std::uint8_t> info = encode_recording_info(make_info());
-    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), info.data(), info.size(), &err));
-    ASSERT_TRUE(w.write(2, "rtfuse/hal/cam0", buf.data(), static_cast<std::size_t>(size), &err));
-    ASSERT_TRUE(test::write_recording_end(w, 2, &err)) << err;
-    ASSERT_TRUE(w.close(&err)) << err;
-  }
   EventLogReader reader;
   ASSERT_TRUE(reader.open(file.path(), &err)) << err;
   HalRecording rec;
@@ -205,18 +209,9 @@ TEST(HalVideoLoader, FramesBeyondTheMemoryAllowedAreRefusedBeforeTheyAreHeld) {
   ev.length = 3u << 20;  // a 3 MiB buffer holding 64 bytes, as an MJPEG frame may
   const int size = codec.encode_video(ev, frame.data(), buf.data(), static_cast<int>(buf.size()));
   ASSERT_GT(size, 0);
+  const std::vector<std::uint8_t> record(buf.begin(), buf.begin() + size);
+  write_camera_recording(file.path(), {record, record, record});
   std::string err;
-  {
-    EventLogWriter w;
-    ASSERT_TRUE(w.open(file.path(), &err)) << err;
-    const std::vector<std::uint8_t> info = encode_recording_info(make_info());
-    ASSERT_TRUE(w.write(1, std::string(kRecordingInfoChannel), info.data(), info.size(), &err));
-    for (int i = 0; i < 3; ++i) {
-      ASSERT_TRUE(w.write(2 + i, "rtfuse/hal/cam0", buf.data(), static_cast<std::size_t>(size), &err));
-    }
-    ASSERT_TRUE(test::write_recording_end(w, 4, &err)) << err;
-    ASSERT_TRUE(w.close(&err)) << err;
-  }
   HalRecordingOptions options;
   options.max_frame_bytes = 8u << 20;  // two frames fit, the third does not
   EventLogReader reader;
