@@ -334,7 +334,7 @@ def show(title, stamp, d):
           f"{l.measurements_fused} measurements fused")
     for s in d.sensors:
         rejected = (s.rejected_mahalanobis + s.rejected_invalid + s.rejected_stale
-                    + s.rejected_overflow + s.decode_errors)
+                    + s.rejected_overflow + s.rejected_rate + s.rejected_oversize + s.decode_errors)
         print(f"  sensor {s.name}: {LEVEL.get(s.level, s.level)}, {s.rate_hz:.1f} Hz, received {s.received}, "
               f"accepted {s.accepted}, rejected {rejected}, timeouts {s.timeouts}")
     for dev in d.devices:

@@ -32,15 +32,14 @@ void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::Snapshot& s, std
               s.initialized ? "true" : "false", events, ticks, published, s.unknown_channel_messages);
   for (int i = 0; i < s.num_sensors; ++i) {
     const rtfuse::SensorStats& st = s.sensors[i];
-    const std::int64_t rejected = st.rejected_mahalanobis + st.rejected_invalid + st.rejected_stale +
-                                  st.rejected_overflow + st.decode_errors;
     std::printf("%s\"%s\": {\"received\": %" PRId64 ", \"accepted\": %" PRId64 ", \"rejected\": %" PRId64
                 ", \"rejected_mahalanobis\": %" PRId64 ", \"rejected_invalid\": %" PRId64
-                ", \"rejected_stale\": %" PRId64 ", \"rejected_overflow\": %" PRId64 ", \"decode_errors\": %" PRId64
-                ", \"yaw_conflicts\": %" PRId64 "}",
-                i ? ", " : "", cfg.sensors[i].name.c_str(), st.received, st.accepted, rejected,
+                ", \"rejected_stale\": %" PRId64 ", \"rejected_overflow\": %" PRId64 ", \"rejected_rate\": %" PRId64
+                ", \"rejected_oversize\": %" PRId64 ", \"decode_errors\": %" PRId64 ", \"yaw_conflicts\": %" PRId64
+                "}",
+                i ? ", " : "", cfg.sensors[i].name.c_str(), st.received, st.accepted, rtfuse::rejected_total(st),
                 st.rejected_mahalanobis, st.rejected_invalid, st.rejected_stale, st.rejected_overflow,
-                st.decode_errors, st.yaw_conflicts);
+                st.rejected_rate, st.rejected_oversize, st.decode_errors, st.yaw_conflicts);
   }
   // Device health at the end (a HAL recording's): what rtfused prints when it stops.
   std::printf("}, \"devices\": {");

@@ -27,6 +27,10 @@ struct SensorConfig {
   Name channel;     // LCM channel (the ROS topic, unchanged); empty for drivers
   SensorSource source = SensorSource::kLcm;
   est::SensorParams params;
+  // LCM sensors: messages beyond this rate (a burst of one ring, 2 x
+  // queue_size, allowed) are dropped before decoding and counted. The loader
+  // resolves an absent key to what the loop drains, 2 x queue_size per tick.
+  double max_rate_hz = 0.0;
 };
 
 struct StaticTransformConfig {
@@ -49,6 +53,9 @@ struct PublishConfig {
   Name state_channel{"rtfuse/state"};
   Name diagnostics_channel{"rtfuse/diagnostics"};
   Name set_pose_channel{"rtfuse/set_pose"};
+  // set_pose resets the estimate, and LCM has no authentication: anyone on
+  // the multicast group could send it. Ignored (and counted) unless enabled.
+  bool accept_set_pose = false;
   double odometry_rate_hz = 50.0;
   double pose_rate_hz = 50.0;
   double tf_rate_hz = 50.0;
@@ -92,6 +99,9 @@ struct RuntimeConfig {
   Name map_frame{"map"};
   est::FilterParams filter;
   std::string lcm_url = "udpm://239.255.76.67:7667?ttl=0";
+  // Largest input message taken from LCM; larger ones are dropped undecoded
+  // and counted (every input type is well under 1 KiB with short frame names).
+  int lcm_max_message_bytes = 4096;
   RealtimeConfig realtime;
   PublishConfig publish;
   std::array<SensorConfig, kMaxSensors> sensors{};

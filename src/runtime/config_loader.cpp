@@ -117,8 +117,10 @@ void read_realtime(const Section& s, RealtimeConfig& rt) {
   s.read("require", rt.require);
 }
 
-void read_lcm(const Section& s, std::string& url_out) {
-  s.reject_unknown({"url"});
+void read_lcm(const Section& s, RuntimeConfig& cfg) {
+  s.reject_unknown({"url", "max_message_bytes"});
+  read_int(s, "max_message_bytes", cfg.lcm_max_message_bytes, 256, 1 << 20);
+  std::string& url_out = cfg.lcm_url;
   std::string url;
   if (!s.read("url", url)) return;
   const std::size_t sep = url.find("://");
@@ -142,7 +144,7 @@ struct ChannelUse {
 void read_publish(const Section& s, PublishConfig& p, std::vector<ChannelUse>& channels) {
   s.reject_unknown({"odometry_channel", "odometry_rate", "pose_channel", "pose_rate", "tf_channel",
                     "tf_rate", "state_channel", "state_rate", "diagnostics_channel",
-                    "diagnostics_rate", "set_pose_channel", "publish_tf"});
+                    "diagnostics_rate", "set_pose_channel", "accept_set_pose", "publish_tf"});
   const std::pair<std::string_view, Name*> names[] = {
       {"odometry_channel", &p.odometry_channel}, {"pose_channel", &p.pose_channel},
       {"tf_channel", &p.tf_channel},             {"state_channel", &p.state_channel},
@@ -166,6 +168,7 @@ void read_publish(const Section& s, PublishConfig& p, std::vector<ChannelUse>& c
                 "must be >= 0 and <= 10000 Hz (0 disables)");
   }
   s.read("publish_tf", p.publish_tf);
+  s.read("accept_set_pose", p.accept_set_pose);
 }
 
 std::optional<est::SensorKind> parse_kind(std::string_view t) {
@@ -241,7 +244,7 @@ struct SensorEntry {
 SensorEntry read_sensor(const Section& s) {
   s.reject_unknown({"name", "type", "channel", "source", "config", "differential", "relative", "queue_size",
                     "pose_rejection_threshold", "twist_rejection_threshold",
-                    "linear_acceleration_rejection_threshold", "remove_gravitational_acceleration"});
+                    "linear_acceleration_rejection_threshold", "remove_gravitational_acceleration", "max_rate"});
   s.require({"name", "type"});
   SensorEntry e;
   est::SensorParams& p = e.cfg.params;
@@ -264,8 +267,12 @@ SensorEntry read_sensor(const Section& s) {
   if (source == "lcm") {
     s.require({"channel"});
     e.has_channel = s.read_name("channel", e.cfg.channel);
-  } else if (s.has("channel")) {
-    s.key_error("channel", "not used with source = " + in_quotes(source) + " (the driver feeds this sensor)");
+    read_number(s, "max_rate", e.cfg.max_rate_hz, [](double v) { return v > 0 && v <= 1e6; },
+                "must be > 0 and <= 1e6 Hz");
+  } else {
+    for (std::string_view k : {"channel", "max_rate"}) {
+      if (s.has(k)) s.key_error(k, "not used with source = " + in_quotes(source) + " (the driver feeds this sensor)");
+    }
   }
   s.require({"config"});
 
@@ -424,10 +431,15 @@ void read_root(const Section& root, RuntimeConfig& cfg) {
   Diagnostics& d = root.diag();
   read_filter(Section(section_table(root, "filter"), "filter", d), cfg);
   read_realtime(Section(section_table(root, "realtime"), "realtime", d), cfg.realtime);
-  read_lcm(Section(section_table(root, "lcm"), "lcm", d), cfg.lcm_url);
+  read_lcm(Section(section_table(root, "lcm"), "lcm", d), cfg);
   std::vector<ChannelUse> publish_channels;
   read_publish(Section(section_table(root, "publish"), "publish", d), cfg.publish, publish_channels);
   read_sensors(root, cfg, publish_channels);
+  // Absent max_rate: what the loop drains per second (2 x queue_size a tick).
+  for (int i = 0; i < cfg.num_sensors; ++i) {
+    SensorConfig& sc = cfg.sensors[static_cast<std::size_t>(i)];
+    if (sc.max_rate_hz == 0.0) sc.max_rate_hz = 2.0 * sc.params.queue_size * cfg.rate_hz;
+  }
   read_static_transforms(root, cfg);
   config::read_hardware(root, cfg);
   read_sim(Section(section_table(root, "sim"), "sim", d), cfg.sim);

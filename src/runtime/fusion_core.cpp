@@ -170,6 +170,7 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
   s.unknown_channel_messages = input_->unknown_channel_messages();
   s.set_pose_count = set_pose_count_;
   s.set_pose_rejected = set_pose_rejected_ + input_->set_pose_decode_errors();
+  s.set_pose_ignored = input_->set_pose_ignored();
   s.num_sensors = cfg_.num_sensors;
   for (int i = 0; i < cfg_.num_sensors; ++i) {
     SensorStats st = stats_[i];
@@ -177,6 +178,8 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
     st.received = c.received.load(std::memory_order_relaxed);
     st.decode_errors = c.decode_errors.load(std::memory_order_relaxed);
     st.rejected_overflow = c.overflow.load(std::memory_order_relaxed);
+    st.rejected_rate = c.rate_limited.load(std::memory_order_relaxed);
+    st.rejected_oversize = c.oversize.load(std::memory_order_relaxed);
     s.sensors[i] = st;
   }
   s.num_devices = 0;

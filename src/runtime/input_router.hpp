@@ -24,6 +24,8 @@ struct InputCounters {
   std::atomic<std::int64_t> received{0};
   std::atomic<std::int64_t> decode_errors{0};
   std::atomic<std::int64_t> overflow{0};
+  std::atomic<std::int64_t> oversize{0};      // above [lcm] max_message_bytes, not decoded
+  std::atomic<std::int64_t> rate_limited{0};  // beyond the sensor's max_rate, not decoded
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 };
 
@@ -32,7 +34,10 @@ class InputRouter {
   InputRouter(const RuntimeConfig& cfg, const geometry::FrameTree& frames);
 
   // One producer thread only. Returns false for channels that are not inputs.
-  bool on_message(const char* channel, const std::uint8_t* data, int size) noexcept;
+  // `now` is when the message arrived (CLOCK_MONOTONIC live, the log's time
+  // in a replay): the rate limits count in it, so a replay drops what the
+  // live run dropped.
+  bool on_message(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept;
 
   // Consumer side (the loop).
   SpscRing<est::SensorSample>& ring(int sensor) { return *rings_[sensor]; }
@@ -48,7 +53,10 @@ class InputRouter {
     return false;
   }
   std::int64_t unknown_channel_messages() const { return unknown_.load(std::memory_order_relaxed); }
+  // Malformed or oversize set_pose messages.
   std::int64_t set_pose_decode_errors() const { return set_pose_errors_.load(std::memory_order_relaxed); }
+  // set_pose messages dropped because [publish] accept_set_pose is false.
+  std::int64_t set_pose_ignored() const { return set_pose_ignored_.load(std::memory_order_relaxed); }
   int num_sensors() const { return num_sensors_; }
 
  private:
@@ -60,6 +68,28 @@ class InputRouter {
   InputCounters counters_[kMaxSensors];
   std::atomic<std::int64_t> unknown_{0};
   std::atomic<std::int64_t> set_pose_errors_{0};
+  std::atomic<std::int64_t> set_pose_ignored_{0};
+  // Rate limit per sensor, the generic cell rate algorithm: a message is
+  // taken when its theoretical arrival time is at most `tolerance` ahead of
+  // now. Integer nanoseconds, so a replay decides exactly as the live run.
+  // An interval of 0 admits everything (a config built without the loader).
+  struct RateLimit {
+    TimeNs interval = 0;   // 1 / max_rate
+    TimeNs tolerance = 0;  // (burst - 1) intervals
+    TimeNs tat = 0;        // theoretical arrival time of the next message
+    bool started = false;
+    bool admit(TimeNs now) noexcept {
+      if (!started) {
+        started = true;
+        tat = now;
+      }
+      const TimeNs next = tat > now ? tat : now;
+      if (next - now > tolerance) return false;
+      tat = next + interval;
+      return true;
+    }
+  };
+  RateLimit limits_[kMaxSensors];
   est::SensorSample scratch_;
 };
 

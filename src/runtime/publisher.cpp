@@ -99,11 +99,6 @@ void fill_twist(const Snapshot& s, rtfuse::twist_with_covariance_t& t) noexcept 
     for (int c = 0; c < 6; ++c) t.covariance[r * 6 + c] = cov(s, 6 + r, 6 + c);
 }
 
-std::int64_t rejections(const SensorStats& st) noexcept {
-  return st.rejected_mahalanobis + st.rejected_invalid + st.rejected_stale + st.rejected_overflow +
-         st.decode_errors;
-}
-
 }  // namespace
 
 struct Publisher::Impl {
@@ -319,6 +314,8 @@ int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, Message
     d.loop.lagged_replays = s.loop.lagged_replays;
     d.unknown_channel_messages = s.unknown_channel_messages;
     d.set_pose_count = s.set_pose_count;
+    d.set_pose_rejected = s.set_pose_rejected;
+    d.set_pose_ignored = s.set_pose_ignored;
     for (int i = 0; i < m.num_sensors; ++i) {
       const SensorStats& in = s.sensors[i];
       auto& out = d.sensors[static_cast<std::size_t>(i)];
@@ -330,13 +327,15 @@ int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, Message
       out.rejected_invalid = in.rejected_invalid;
       out.rejected_stale = in.rejected_stale;
       out.rejected_overflow = in.rejected_overflow;
+      out.rejected_rate = in.rejected_rate;
+      out.rejected_oversize = in.rejected_oversize;
       out.decode_errors = in.decode_errors;
       out.yaw_conflicts = in.yaw_conflicts;
       out.timeouts = in.timeouts;
       out.timed_out = in.timed_out;
       // WARN compares with the previous message so that one bad burst does
       // not keep a sensor yellow for the rest of the run.
-      const std::int64_t rejected = rejections(in);
+      const std::int64_t rejected = rejected_total(in);
       auto& previous = m.rejections_at_last_diagnostics[static_cast<std::size_t>(i)];
       if (in.received == 0) {
         out.level = rtfuse::sensor_status_t::STALE;

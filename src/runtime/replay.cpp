@@ -92,7 +92,7 @@ ReplayResult Replay::run(transport::EventLogReader& in, transport::EventLogWrite
     const std::size_t n = std::min<std::size_t>(ev.channel.size(), sizeof(channel) - 1);
     std::memcpy(channel, ev.channel.data(), n);
     channel[n] = '\0';
-    core_->input().on_message(channel, ev.data, static_cast<int>(ev.size));
+    core_->input().on_message(channel, ev.data, static_cast<int>(ev.size), t);
     ++prog.events;
     prog.log_time = t - first;
     if (progress && prog.events % 1000 == 0) progress(prog);

@@ -57,7 +57,7 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
 Runtime::~Runtime() { stop(); }
 
 void Runtime::on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user) {
-  static_cast<FusionCore*>(user)->input().on_message(channel, data, size);
+  static_cast<FusionCore*>(user)->input().on_message(channel, data, size, monotonic_now_ns());
 }
 
 bool Runtime::start(std::string* error, std::string* warnings) {

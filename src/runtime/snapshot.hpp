@@ -17,11 +17,19 @@ struct SensorStats {
   std::int64_t rejected_invalid = 0;   // NaN/Inf, bad covariance, no transform, out of order
   std::int64_t rejected_stale = 0;     // older than the history
   std::int64_t rejected_overflow = 0;  // ring full: the loop fell behind
+  std::int64_t rejected_rate = 0;      // beyond the sensor's max_rate, not decoded
+  std::int64_t rejected_oversize = 0;  // above [lcm] max_message_bytes, not decoded
   std::int64_t decode_errors = 0;
   std::int64_t yaw_conflicts = 0;
   std::int64_t timeouts = 0;
   bool timed_out = false;
 };
+
+// Every message of a sensor that did not reach the filter or was refused by it.
+inline std::int64_t rejected_total(const SensorStats& st) noexcept {
+  return st.rejected_mahalanobis + st.rejected_invalid + st.rejected_stale + st.rejected_overflow +
+         st.rejected_rate + st.rejected_oversize + st.decode_errors;
+}
 
 struct LoopStats {
   double rate_hz = 0.0;
@@ -56,7 +64,8 @@ struct Snapshot {
   LoopStats loop;
   std::int64_t unknown_channel_messages = 0;
   std::int64_t set_pose_count = 0;
-  std::int64_t set_pose_rejected = 0;  // frame not connected to the world frame
+  std::int64_t set_pose_rejected = 0;  // malformed, oversize, or a frame not connected to the world frame
+  std::int64_t set_pose_ignored = 0;   // [publish] accept_set_pose = false
   int num_sensors = 0;
   SensorStats sensors[kMaxSensors];
   int num_devices = 0;

@@ -389,9 +389,9 @@ void BM_LoopTick(benchmark::State& state) {
   loop.period_ns = 20'000'000;
   auto cycle = [&]() {
     patch_utime(imu.data(), t_us);
-    core->input().on_message("imu", imu.data(), imu_size);
+    core->input().on_message("imu", imu.data(), imu_size, rtfuse::utime_to_ns(t_us));
     patch_utime(odom.data(), t_us + kPeriodUs / 2);
-    core->input().on_message("odom", odom.data(), odom_size);
+    core->input().on_message("odom", odom.data(), odom_size, rtfuse::utime_to_ns(t_us + kPeriodUs / 2));
     ++loop.ticks;
     core->tick(rtfuse::utime_to_ns(t_us + kPeriodUs / 2) + 1'000'000, loop);
     t_us += kPeriodUs;
@@ -426,6 +426,99 @@ void BM_LoopTick(benchmark::State& state) {
   }
 }
 BENCHMARK(BM_LoopTick);
+
+// A flood on the IMU channel (issue 11, "Inputs from the network"): 1000
+// valid-looking messages per 20 ms period, 50 kHz, from a sender on the LCM
+// group. With max_rate at what the loop drains (2 x queue_size x 50 Hz =
+// 1000 Hz), the LCM thread drops the excess before decoding; the loop's
+// tick, timed alone, fuses at most the ring's 20 per sensor.
+void BM_LoopTickUnderFlood(benchmark::State& state) {
+  rtfuse::RuntimeConfig cfg = jackal_config();
+  for (int i = 0; i < cfg.num_sensors; ++i) {
+    cfg.sensors[i].max_rate_hz = 2.0 * cfg.sensors[i].params.queue_size * cfg.rate_hz;
+  }
+  std::string error;
+  std::unique_ptr<rtfuse::FusionCore> core = rtfuse::FusionCore::create(cfg, &error);
+  if (!core) {
+    state.SkipWithError(("FusionCore::create: " + error).c_str());
+    return;
+  }
+  std::vector<std::uint8_t> odom = encoded_odometry();
+  std::vector<std::uint8_t> imu = encoded_imu();
+  const int odom_size = static_cast<int>(odom.size());
+  const int imu_size = static_cast<int>(imu.size());
+  constexpr std::int64_t kPeriodUs = 20'000;
+  constexpr int kFlood = 1000;
+  std::int64_t t_us = 1'000'000;
+  rtfuse::LoopStats loop;
+  loop.rate_hz = 50.0;
+  loop.period_ns = 20'000'000;
+  auto flood = [&]() {
+    for (int k = 0; k < kFlood; ++k) {
+      const std::int64_t at = t_us + k * kPeriodUs / kFlood;
+      patch_utime(imu.data(), at);
+      core->input().on_message("imu", imu.data(), imu_size, rtfuse::utime_to_ns(at));
+    }
+    patch_utime(odom.data(), t_us + kPeriodUs / 2);
+    core->input().on_message("odom", odom.data(), odom_size, rtfuse::utime_to_ns(t_us + kPeriodUs / 2));
+  };
+  auto tick = [&]() {
+    ++loop.ticks;
+    core->tick(rtfuse::utime_to_ns(t_us + kPeriodUs), loop);
+    t_us += kPeriodUs;
+  };
+  for (int i = 0; i < 20; ++i) {
+    flood();
+    tick();
+  }
+  rtfuse::Snapshot s0;
+  core->snapshot().load(s0);
+  AllocScope allocs;
+  for (auto _ : state) {
+    flood();
+    const auto start = std::chrono::steady_clock::now();
+    tick();
+    const auto end = std::chrono::steady_clock::now();
+    state.SetIterationTime(std::chrono::duration<double>(end - start).count());
+  }
+  report_allocations(state, allocs.count());
+  rtfuse::Snapshot s1;
+  core->snapshot().load(s1);
+  const auto per_tick = [&](std::int64_t a, std::int64_t b) {
+    return benchmark::Counter(static_cast<double>(b - a), benchmark::Counter::kAvgIterations);
+  };
+  state.counters["imu_fused_per_tick"] = per_tick(s0.sensors[1].accepted, s1.sensors[1].accepted);
+  state.counters["imu_rate_limited_per_tick"] = per_tick(s0.sensors[1].rejected_rate, s1.sensors[1].rejected_rate);
+  state.counters["imu_overflow_per_tick"] = per_tick(s0.sensors[1].rejected_overflow, s1.sensors[1].rejected_overflow);
+}
+BENCHMARK(BM_LoopTickUnderFlood)->UseManualTime();
+
+// What one flooding message costs the LCM thread once the rate limit drops
+// it (a channel compare and the limiter), against decoding it.
+void BM_InputMessage(benchmark::State& state) {
+  const bool limited = state.range(0) != 0;
+  rtfuse::RuntimeConfig cfg = jackal_config();
+  cfg.sensors[1].max_rate_hz = limited ? 1.0 : 0.0;  // 0: no limit
+  std::string error;
+  std::unique_ptr<rtfuse::FusionCore> core = rtfuse::FusionCore::create(cfg, &error);
+  if (!core) {
+    state.SkipWithError(("FusionCore::create: " + error).c_str());
+    return;
+  }
+  std::vector<std::uint8_t> imu = encoded_imu();
+  const int imu_size = static_cast<int>(imu.size());
+  rtfuse::TimeNs now = 1'000'000'000;
+  // Fill the burst allowance and the ring first: from then on every
+  // message is dropped, by the limiter or (unlimited) as overflow after its
+  // decode.
+  for (int i = 0; i < 100; ++i) core->input().on_message("imu", imu.data(), imu_size, now);
+  for (auto _ : state) {
+    ++now;
+    benchmark::DoNotOptimize(core->input().on_message("imu", imu.data(), imu_size, now));
+  }
+  state.SetLabel(limited ? "dropped by max_rate" : "decoded, then ring full");
+}
+BENCHMARK(BM_InputMessage)->Arg(1)->Arg(0);
 
 // ---------------------------------------------------------------------------
 // The shared Jackal bag, end to end

@@ -294,6 +294,37 @@ TEST(ConfigLoader, SensorDefaults) {
   EXPECT_FALSE(p.remove_gravitational_acceleration);
 }
 
+TEST(ConfigLoader, InputLimitsFromTheNetwork) {
+  // Defaults: set_pose ignored, 4 KiB messages, a sensor's rate what the
+  // loop drains (2 x queue_size per tick at [filter] frequency).
+  {
+    const auto r = load("[filter]\nfrequency = 50\n" + sensor("imu0", "imu", "imu/data", "queue_size = 4\n"));
+    const RuntimeConfig& c = ok_config(r);
+    EXPECT_FALSE(c.publish.accept_set_pose);
+    EXPECT_EQ(c.lcm_max_message_bytes, 4096);
+    EXPECT_DOUBLE_EQ(c.sensors[0].max_rate_hz, 400.0);
+  }
+  const auto r = load("[lcm]\nmax_message_bytes = 1024\n[publish]\naccept_set_pose = true\n" +
+                      sensor("imu0", "imu", "imu/data", "max_rate = 250.0\n"));
+  const RuntimeConfig& c = ok_config(r);
+  EXPECT_TRUE(c.publish.accept_set_pose);
+  EXPECT_EQ(c.lcm_max_message_bytes, 1024);
+  EXPECT_DOUBLE_EQ(c.sensors[0].max_rate_hz, 250.0);
+
+  EXPECT_EQ(single_error(load("[lcm]\nmax_message_bytes = 100\n")),
+            "test.toml:2:21: lcm.max_message_bytes: must be between 256 and 1048576, got 100");
+  EXPECT_EQ(single_error(load(sensor("a", "imu", "c", "max_rate = 0.0\n"))),
+            "test.toml:6:12: sensor[0].max_rate: must be > 0 and <= 1e6 Hz, got 0");
+  // A driver-fed sensor has no channel to limit (the other errors: the
+  // [wheel_odometry] keys this snippet leaves out).
+  const std::string driver = all_errors(load(
+      "[[sensor]]\nname = \"w\"\ntype = \"twist\"\nsource = \"wheel_odometry\"\nconfig = [false, false, false, "
+      "false, false, false, true, false, false, false, false, false, false, false, false]\nmax_rate = 10.0\n"));
+  EXPECT_NE(driver.find("test.toml:6:1: sensor[0].max_rate: not used with source = 'wheel_odometry' (the driver feeds"),
+            std::string::npos)
+      << driver;
+}
+
 TEST(ConfigLoader, ExampleRobotConfigLoads) {
   const std::string path = RTFUSE_SOURCE_DIR "/config/example_robot.toml";
   const auto r = load_config_file(path);

@@ -78,10 +78,10 @@ TEST(FusionCore, ConflictingAbsoluteYawIsGatedNotAveraged) {
   TimeNs t = 1'000'000'000;
   for (int i = 0; i < 200; ++i, t += 10'000'000) {
     auto a = odometry(t, 0.0, 0.0);
-    ASSERT_TRUE(core->input().on_message("odom", a.data(), static_cast<int>(a.size())));
+    ASSERT_TRUE(core->input().on_message("odom", a.data(), static_cast<int>(a.size()), t));
     if (i % 5 == 0) {
       auto b = odometry(t, 1.0, 0.0);  // a compass 1 rad off
-      core->input().on_message("compass", b.data(), static_cast<int>(b.size()));
+      core->input().on_message("compass", b.data(), static_cast<int>(b.size()), t);
     }
     core->tick(t, loop);
     EXPECT_LT(std::abs(snap(*core).state[5]), 0.05) << "yaw pulled away at step " << i;
@@ -98,9 +98,9 @@ TEST(FusionCore, MessageOlderThanThePreviousOfItsSensorIsRejected) {
   LoopStats loop;
   auto m1 = odometry(2'000'000'000, 0.0, 1.0);
   auto m0 = odometry(1'000'000'000, 0.0, 1.0);  // time goes backwards
-  core->input().on_message("odom", m1.data(), static_cast<int>(m1.size()));
+  core->input().on_message("odom", m1.data(), static_cast<int>(m1.size()), 2'000'000'000);
   core->tick(2'000'000'000, loop);
-  core->input().on_message("odom", m0.data(), static_cast<int>(m0.size()));
+  core->input().on_message("odom", m0.data(), static_cast<int>(m0.size()), 2'005'000'000);
   core->tick(2'010'000'000, loop);
   const Snapshot s = snap(*core);
   EXPECT_EQ(s.sensors[0].accepted, 1);
@@ -111,9 +111,11 @@ TEST(FusionCore, RingOverflowIsCountedNotHidden) {
   std::string err;
   auto core = FusionCore::create(load(kTwoYawSources), &err);
   ASSERT_TRUE(core) << err;
-  for (int i = 0; i < 10; ++i) {  // compass ring holds 2 * queue_size = 4
+  // Within the compass's rate (2 x queue_size x 100 Hz = 400 Hz), faster
+  // than the loop drains: the ring (2 x queue_size = 4) overflows.
+  for (int i = 0; i < 10; ++i) {
     auto b = odometry(1'000'000'000 + i, 0.0, 0.0);
-    core->input().on_message("compass", b.data(), static_cast<int>(b.size()));
+    core->input().on_message("compass", b.data(), static_cast<int>(b.size()), 1'000'000'000 + i * 2'500'000LL);
   }
   core->tick(1'100'000'000, LoopStats{});
   const Snapshot s = snap(*core);
@@ -122,19 +124,7 @@ TEST(FusionCore, RingOverflowIsCountedNotHidden) {
   EXPECT_EQ(s.sensors[1].accepted, 4);
 }
 
-TEST(FusionCore, SetPoseChannelResetsTheEstimate) {
-  std::string err;
-  RuntimeConfig cfg = load(kTwoYawSources);
-  auto core = FusionCore::create(cfg, &err);
-  ASSERT_TRUE(core) << err;
-  TimeNs t = 1'000'000'000;
-  for (int i = 0; i < 100; ++i, t += 10'000'000) {
-    auto a = odometry(t, 0.0, 1.0);
-    core->input().on_message("odom", a.data(), static_cast<int>(a.size()));
-    core->tick(t, LoopStats{});
-  }
-  EXPECT_GT(snap(*core).state[0], 0.9);  // drove ~1 m
-
+std::vector<std::uint8_t> set_pose_message(TimeNs t) {
   rtfuse::pose_with_covariance_stamped_t p{};
   p.header.utime = ns_to_utime(t);
   p.header.frame_id = "odom";
@@ -144,7 +134,26 @@ TEST(FusionCore, SetPoseChannelResetsTheEstimate) {
   for (int i = 0; i < 6; ++i) p.pose.covariance[i * 7] = 0.1;
   std::vector<std::uint8_t> buf(p.getEncodedSize());
   p.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  ASSERT_TRUE(core->input().on_message(cfg.publish.set_pose_channel.c_str(), buf.data(), static_cast<int>(buf.size())));
+  return buf;
+}
+
+TEST(FusionCore, SetPoseChannelResetsTheEstimate) {
+  std::string err;
+  RuntimeConfig cfg = load(kTwoYawSources);
+  cfg.publish.accept_set_pose = true;
+  auto core = FusionCore::create(cfg, &err);
+  ASSERT_TRUE(core) << err;
+  TimeNs t = 1'000'000'000;
+  for (int i = 0; i < 100; ++i, t += 10'000'000) {
+    auto a = odometry(t, 0.0, 1.0);
+    core->input().on_message("odom", a.data(), static_cast<int>(a.size()), t);
+    core->tick(t, LoopStats{});
+  }
+  EXPECT_GT(snap(*core).state[0], 0.9);  // drove ~1 m
+
+  const std::vector<std::uint8_t> buf = set_pose_message(t);
+  const char* channel = cfg.publish.set_pose_channel.c_str();
+  ASSERT_TRUE(core->input().on_message(channel, buf.data(), static_cast<int>(buf.size()), t));
   core->tick(t, LoopStats{});
   const Snapshot s = snap(*core);
   EXPECT_NEAR(s.state[0], 5.0, 1e-9);
@@ -155,12 +164,64 @@ TEST(FusionCore, SetPoseChannelResetsTheEstimate) {
   EXPECT_EQ(s.set_pose_count, 1);
 }
 
+TEST(FusionCore, SetPoseIsIgnoredAndCountedUnlessAccepted) {
+  // LCM has no authentication: by default a set_pose from anyone on the
+  // group changes nothing, and diagnostics count it.
+  std::string err;
+  const RuntimeConfig cfg = load(kTwoYawSources);
+  ASSERT_FALSE(cfg.publish.accept_set_pose);
+  auto core = FusionCore::create(cfg, &err);
+  ASSERT_TRUE(core) << err;
+  const std::vector<std::uint8_t> buf = set_pose_message(1'000'000'000);
+  EXPECT_TRUE(core->input().on_message("rtfuse/set_pose", buf.data(), static_cast<int>(buf.size()), 1'000'000'000));
+  core->tick(1'000'000'000, LoopStats{});
+  const Snapshot s = snap(*core);
+  EXPECT_EQ(s.set_pose_count, 0);
+  EXPECT_EQ(s.set_pose_ignored, 1);
+  EXPECT_EQ(s.state[0], 0.0);
+}
+
+TEST(FusionCore, AFloodIsRateLimitedBeforeDecodingAndOversizeMessagesAreDropped) {
+  // odom: queue_size 10 at 100 Hz, so 2000 messages/s with a burst of 20.
+  std::string err;
+  const RuntimeConfig cfg = load(kTwoYawSources);
+  EXPECT_DOUBLE_EQ(cfg.sensors[0].max_rate_hz, 2000.0);
+  auto core = FusionCore::create(cfg, &err);
+  ASSERT_TRUE(core) << err;
+  const TimeNs t0 = 1'000'000'000;
+  // 1000 copies in one millisecond: the burst of 20 and the 2 the rate adds.
+  for (int i = 0; i < 1000; ++i) {
+    auto a = odometry(t0 + i, 0.0, 1.0);
+    core->input().on_message("odom", a.data(), static_cast<int>(a.size()), t0 + i * 1000);
+  }
+  // Then one message well over [lcm] max_message_bytes (4096 by default).
+  std::vector<std::uint8_t> big = odometry(t0 + 2'000'000, 0.0, 1.0);
+  big.resize(5000, 0);
+  core->input().on_message("odom", big.data(), static_cast<int>(big.size()), t0 + 2'000'000);
+  core->tick(t0 + 2'000'000, LoopStats{});
+  const Snapshot s = snap(*core);
+  EXPECT_EQ(s.sensors[0].received, 1001);
+  EXPECT_EQ(s.sensors[0].rejected_rate, 1000 - 21);
+  EXPECT_EQ(s.sensors[0].rejected_oversize, 1);
+  EXPECT_EQ(s.sensors[0].rejected_overflow, 1);  // the 21st: the ring holds 20 and the loop has not ticked
+  EXPECT_EQ(s.sensors[0].decode_errors, 0);
+
+  // At its rate again, every message passes.
+  for (int i = 0; i < 100; ++i) {
+    const TimeNs t = t0 + 1'000'000'000 + i * 10'000'000LL;
+    auto a = odometry(t, 0.0, 1.0);
+    core->input().on_message("odom", a.data(), static_cast<int>(a.size()), t);
+    core->tick(t, LoopStats{});
+  }
+  EXPECT_EQ(snap(*core).sensors[0].rejected_rate, 1000 - 21);
+}
+
 TEST(FusionCore, UnknownChannelIsCounted) {
   std::string err;
   auto core = FusionCore::create(load(kTwoYawSources), &err);
   ASSERT_TRUE(core) << err;
   const std::uint8_t junk[4] = {1, 2, 3, 4};
-  EXPECT_FALSE(core->input().on_message("nobody/listens", junk, 4));
+  EXPECT_FALSE(core->input().on_message("nobody/listens", junk, 4, 1));
   core->tick(1, LoopStats{});
   EXPECT_EQ(snap(*core).unknown_channel_messages, 1);
 }
@@ -172,12 +233,12 @@ TEST(FusionCore, SteadyStateTicksDoNotAllocate) {
   std::vector<std::vector<std::uint8_t>> msgs;
   for (int i = 0; i < 300; ++i) msgs.push_back(odometry(1'000'000'000 + i * 10'000'000LL, 0.01 * i, 1.0));
   for (int i = 0; i < 10; ++i) {  // warm up: first decode sizes the strings
-    core->input().on_message("odom", msgs[i].data(), static_cast<int>(msgs[i].size()));
+    core->input().on_message("odom", msgs[i].data(), static_cast<int>(msgs[i].size()), 1'000'000'000 + i * 10'000'000LL);
     core->tick(1'000'000'000 + i * 10'000'000LL, LoopStats{});
   }
   test::AllocScope scope;
   for (int i = 10; i < 300; ++i) {
-    core->input().on_message("odom", msgs[i].data(), static_cast<int>(msgs[i].size()));
+    core->input().on_message("odom", msgs[i].data(), static_cast<int>(msgs[i].size()), 1'000'000'000 + i * 10'000'000LL);
     core->tick(1'000'000'000 + i * 10'000'000LL, LoopStats{});
   }
   EXPECT_EQ(scope.count(), 0u);

@@ -95,7 +95,7 @@ TEST(SimToml, FusedEstimateBeatsRawWheelOdometry) {
         odom_pos.add(odom_final);
         odom_yaw.add(std::remainder(yaw - t.yaw, 2 * kPi));
       }
-      core->input().on_message(m.channel, m.data, m.size);
+      core->input().on_message(m.channel, m.data, m.size, now);
     }
     core->tick(now, LoopStats{});
     Snapshot s;
