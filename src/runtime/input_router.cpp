@@ -59,7 +59,8 @@ bool InputRouter::on_message(const char* channel, const std::uint8_t* data, int 
       set_pose_errors_.fetch_add(1, std::memory_order_relaxed);
       return true;
     }
-    set_pose_ring_.try_push(cmd);
+    // A burst beyond the ring before the loop's next tick: counted, not lost silently.
+    if (!set_pose_ring_.try_push(cmd)) set_pose_errors_.fetch_add(1, std::memory_order_relaxed);
     return true;
   }
   unknown_.fetch_add(1, std::memory_order_relaxed);

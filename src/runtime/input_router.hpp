@@ -53,7 +53,7 @@ class InputRouter {
     return false;
   }
   std::int64_t unknown_channel_messages() const { return unknown_.load(std::memory_order_relaxed); }
-  // Malformed or oversize set_pose messages.
+  // Malformed or oversize set_pose messages, and those the ring had no room for.
   std::int64_t set_pose_decode_errors() const { return set_pose_errors_.load(std::memory_order_relaxed); }
   // set_pose messages dropped because [publish] accept_set_pose is false.
   std::int64_t set_pose_ignored() const { return set_pose_ignored_.load(std::memory_order_relaxed); }

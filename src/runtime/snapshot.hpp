@@ -64,7 +64,7 @@ struct Snapshot {
   LoopStats loop;
   std::int64_t unknown_channel_messages = 0;
   std::int64_t set_pose_count = 0;
-  std::int64_t set_pose_rejected = 0;  // malformed, oversize, or a frame not connected to the world frame
+  std::int64_t set_pose_rejected = 0;  // malformed, oversize, ring full, or a frame not connected to the world frame
   std::int64_t set_pose_ignored = 0;   // [publish] accept_set_pose = false
   int num_sensors = 0;
   SensorStats sensors[kMaxSensors];

@@ -181,6 +181,24 @@ TEST(FusionCore, SetPoseIsIgnoredAndCountedUnlessAccepted) {
   EXPECT_EQ(s.state[0], 0.0);
 }
 
+TEST(FusionCore, SetPoseBeyondItsRingIsCountedAsRejected) {
+  // Six between two ticks: the ring holds four, the other two are counted.
+  std::string err;
+  RuntimeConfig cfg = load(kTwoYawSources);
+  cfg.publish.accept_set_pose = true;
+  auto core = FusionCore::create(cfg, &err);
+  ASSERT_TRUE(core) << err;
+  const TimeNs t = 1'000'000'000;
+  for (int i = 0; i < 6; ++i) {
+    const std::vector<std::uint8_t> buf = set_pose_message(t + i);
+    core->input().on_message("rtfuse/set_pose", buf.data(), static_cast<int>(buf.size()), t + i);
+  }
+  core->tick(t + 10, LoopStats{});
+  const Snapshot s = snap(*core);
+  EXPECT_EQ(s.set_pose_count, 4);
+  EXPECT_EQ(s.set_pose_rejected, 2);
+}
+
 TEST(FusionCore, AFloodIsRateLimitedBeforeDecodingAndOversizeMessagesAreDropped) {
   // odom: queue_size 10 at 100 Hz, so 2000 messages/s with a burst of 20.
   std::string err;
