@@ -33,7 +33,7 @@ while (($#)); do
     *) harnesses+=("$1"); shift ;;
   esac
 done
-all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti)
+all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti daemon_input)
 ((${#harnesses[@]})) || harnesses=("${all[@]}")
 
 "$root/tools/setup-deps.sh"
@@ -66,6 +66,8 @@ fi
 for h in "${all[@]}"; do
   [[ -d "$root/tests/fuzz/regressions/$h" ]] && cp "$root/tests/fuzz/regressions/$h"/* "$seeds/$h/"
 done
+# The daemon's input path takes the decoders' messages, with their selector.
+cp "$seeds/sample_decoder"/* "$seeds/daemon_input/"
 
 # --- runs -----------------------------------------------------------------
 export ASAN_OPTIONS="detect_leaks=1:strict_string_checks=1:detect_stack_use_after_return=1"
@@ -85,8 +87,13 @@ run_one() {  # harness
   corpus=$(find "$dir/corpus/$h" -type f | wc -l)
   local verdict=clean
   if ((rc != 0)); then
-    verdict="FINDING (exit $rc): $(grep -m1 -E 'ERROR:|runtime error|property failed|Assertion' "$log" || echo 'see log'); log $log"
+    verdict="FINDING (exit $rc): $(grep -m1 -E "ERROR:|runtime error|property failed|Assertion|^${h}_fuzz:" "$log" ||
+      echo 'see log'); log $log"
   fi
+  # A harness's own figures (daemon_input: messages, outputs checked, ticks).
+  local own
+  own=$(grep "^${h}_fuzz: .*published" "$log" | tail -1 | sed "s/^${h}_fuzz: //")
+  if [[ -n "$own" ]]; then verdict+=" ($own)"; fi
   printf '%-17s %12s execs %8s/s  cov %5s  ft %6s  corpus %5s  %4ss  %s\n' \
     "$h" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$corpus" "$((SECONDS - start))" "$verdict"
   ((rc == 0))

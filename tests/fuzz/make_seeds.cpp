@@ -92,6 +92,10 @@ int main(int argc, char** argv) {
   write_file(dir + "/sample_decoder/twist", encode(twist), 2, true);
   write_file(dir + "/sample_decoder/imu", encode(imu), 3, true);
   write_file(dir + "/sample_decoder/set_pose", encode(pose), 4, true);
+  // In the world frame of config/sim.toml, so daemon_input_fuzz (which
+  // shares these seeds) starts with a set_pose the filter applies.
+  pose.header.frame_id = "odom";
+  write_file(dir + "/sample_decoder/set_pose_odom", encode(pose), 4, true);
 
   // --- a HAL recording ---------------------------------------------------
   // The device table of hal_record_codec_fuzz.cpp, so each record seeds it too.
