@@ -122,9 +122,15 @@ void report() {
                static_cast<long long>(s.set_pose_count), static_cast<long long>(s.set_pose_rejected));
   for (int i = 0; i < s.num_sensors; ++i) {
     const rtfuse::SensorStats& st = s.sensors[i];
-    std::fprintf(stderr, "daemon_input_fuzz: sensor %s: received %lld accepted %lld rejected %lld\n",
+    std::fprintf(stderr,
+                 "daemon_input_fuzz: sensor %s: received %lld accepted %lld rejected %lld (mahalanobis %lld, "
+                 "invalid %lld, stale %lld, overflow %lld, rate %lld, oversize %lld, decode %lld)\n",
                  d.cfg.sensors[i].name.c_str(), static_cast<long long>(st.received),
-                 static_cast<long long>(st.accepted), static_cast<long long>(rtfuse::rejected_total(st)));
+                 static_cast<long long>(st.accepted), static_cast<long long>(rtfuse::rejected_total(st)),
+                 static_cast<long long>(st.rejected_mahalanobis), static_cast<long long>(st.rejected_invalid),
+                 static_cast<long long>(st.rejected_stale), static_cast<long long>(st.rejected_overflow),
+                 static_cast<long long>(st.rejected_rate), static_cast<long long>(st.rejected_oversize),
+                 static_cast<long long>(st.decode_errors));
   }
   if (after <= before) {
     std::fprintf(stderr, "daemon_input_fuzz: the daemon stopped publishing\n");
