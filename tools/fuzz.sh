@@ -82,17 +82,17 @@ run_one() {  # harness
   local execs cov ft corpus rate
   execs=$(sed -n 's/^stat::number_of_executed_units: *//p' "$log" | tail -1)
   rate=$(sed -n 's/^stat::average_exec_per_sec: *//p' "$log" | tail -1)
-  cov=$(grep -o 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
-  ft=$(grep -o 'ft: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
+  cov=$(grep -ao 'cov: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
+  ft=$(grep -ao 'ft: [0-9]*' "$log" | tail -1 | cut -d' ' -f2)
   corpus=$(find "$dir/corpus/$h" -type f | wc -l)
   local verdict=clean
   if ((rc != 0)); then
-    verdict="FINDING (exit $rc): $(grep -m1 -E "ERROR:|runtime error|property failed|Assertion|^${h}_fuzz:" "$log" ||
+    verdict="FINDING (exit $rc): $(grep -a -m1 -E "ERROR:|runtime error|property failed|Assertion|^${h}_fuzz:" "$log" ||
       echo 'see log'); log $log"
   fi
   # A harness's own figures (daemon_input: messages, outputs checked, ticks).
   local own
-  own=$(grep "^${h}_fuzz: .*published" "$log" | tail -1 | sed "s/^${h}_fuzz: //")
+  own=$(grep -a "^${h}_fuzz: .*published" "$log" | tail -1 | sed "s/^${h}_fuzz: //")
   if [[ -n "$own" ]]; then verdict+=" ($own)"; fi
   printf '%-17s %12s execs %8s/s  cov %5s  ft %6s  corpus %5s  %4ss  %s\n' \
     "$h" "${execs:-?}" "${rate:-?}" "${cov:-?}" "${ft:-?}" "$corpus" "$((SECONDS - start))" "$verdict"
