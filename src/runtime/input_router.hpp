@@ -35,8 +35,9 @@ class InputRouter {
 
   // One producer thread only. Returns false for channels that are not inputs.
   // `now` is when the message arrived (CLOCK_MONOTONIC live, the log's time
-  // in a replay): the rate limits count in it, so a replay drops what the
-  // live run dropped.
+  // in a replay): the rate limits count in it, so replaying a log drops the
+  // same messages every time, and what the live run dropped as far as the
+  // logger's receive times match the daemon's.
   bool on_message(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept;
 
   // Consumer side (the loop).
@@ -71,7 +72,8 @@ class InputRouter {
   std::atomic<std::int64_t> set_pose_ignored_{0};
   // Rate limit per sensor, the generic cell rate algorithm: a message is
   // taken when its theoretical arrival time is at most `tolerance` ahead of
-  // now. Integer nanoseconds, so a replay decides exactly as the live run.
+  // now. Integer nanoseconds: the same arrival times give the same decisions
+  // on every machine.
   // An interval of 0 admits everything (a config built without the loader).
   struct RateLimit {
     TimeNs interval = 0;   // 1 / max_rate
