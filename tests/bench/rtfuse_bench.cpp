@@ -359,14 +359,18 @@ inline void patch_utime(std::uint8_t* bytes, std::int64_t utime) {
   for (int i = 0; i < 8; ++i) bytes[kUtimeOffset + i] = static_cast<std::uint8_t>(u >> (56 - 8 * i));
 }
 
-void BM_LoopTick(benchmark::State& state) {
-  const rtfuse::RuntimeConfig cfg = jackal_config();
+// The benchmarks' FusionCore, or null with the benchmark skipped and why.
+std::unique_ptr<rtfuse::FusionCore> create_core(benchmark::State& state, const rtfuse::RuntimeConfig& cfg) {
   std::string error;
   std::unique_ptr<rtfuse::FusionCore> core = rtfuse::FusionCore::create(cfg, &error);
-  if (!core) {
-    state.SkipWithError(("FusionCore::create: " + error).c_str());
-    return;
-  }
+  if (!core) state.SkipWithError(("FusionCore::create: " + error).c_str());
+  return core;
+}
+
+void BM_LoopTick(benchmark::State& state) {
+  const rtfuse::RuntimeConfig cfg = jackal_config();
+  std::unique_ptr<rtfuse::FusionCore> core = create_core(state, cfg);
+  if (!core) return;
   std::vector<std::uint8_t> odom = encoded_odometry();
   std::vector<std::uint8_t> imu = encoded_imu();
   {
@@ -437,12 +441,8 @@ void BM_LoopTickUnderFlood(benchmark::State& state) {
   for (int i = 0; i < cfg.num_sensors; ++i) {
     cfg.sensors[i].max_rate_hz = 2.0 * cfg.sensors[i].params.queue_size * cfg.rate_hz;
   }
-  std::string error;
-  std::unique_ptr<rtfuse::FusionCore> core = rtfuse::FusionCore::create(cfg, &error);
-  if (!core) {
-    state.SkipWithError(("FusionCore::create: " + error).c_str());
-    return;
-  }
+  std::unique_ptr<rtfuse::FusionCore> core = create_core(state, cfg);
+  if (!core) return;
   std::vector<std::uint8_t> odom = encoded_odometry();
   std::vector<std::uint8_t> imu = encoded_imu();
   const int odom_size = static_cast<int>(odom.size());
@@ -499,12 +499,8 @@ void BM_InputMessage(benchmark::State& state) {
   const bool limited = state.range(0) != 0;
   rtfuse::RuntimeConfig cfg = jackal_config();
   cfg.sensors[1].max_rate_hz = limited ? 1.0 : 0.0;  // 0: no limit
-  std::string error;
-  std::unique_ptr<rtfuse::FusionCore> core = rtfuse::FusionCore::create(cfg, &error);
-  if (!core) {
-    state.SkipWithError(("FusionCore::create: " + error).c_str());
-    return;
-  }
+  std::unique_ptr<rtfuse::FusionCore> core = create_core(state, cfg);
+  if (!core) return;
   std::vector<std::uint8_t> imu = encoded_imu();
   const int imu_size = static_cast<int>(imu.size());
   rtfuse::TimeNs now = 1'000'000'000;
