@@ -43,6 +43,10 @@ bool retryable(HalStatus s) noexcept { return s == HalStatus::kNack || s == HalS
 
 }  // namespace
 
+const char* to_string(I2cTransferMode mode) noexcept {
+  return mode == I2cTransferMode::kI2c ? "I2C (combined I2C_RDWR transfers)" : "SMBus (I2C block reads, byte writes)";
+}
+
 int I2cDevBus::system_ioctl(int fd, unsigned long request, void* arg) noexcept { return ::ioctl(fd, request, arg); }
 
 std::string I2cDevBus::device_path(const std::string& path_or_number) {
@@ -69,7 +73,8 @@ std::string I2cDevBus::describe_open_failure(const std::string& path, int err) {
   return msg;
 }
 
-bool I2cDevBus::check_adapter(int fd, const std::string& path, IoctlFn ioctl_fn, std::string* error) {
+bool I2cDevBus::check_adapter(int fd, const std::string& path, IoctlFn ioctl_fn, I2cTransferMode* mode,
+                              std::string* error) {
   unsigned long funcs = 0;
   if (ioctl_fn(fd, I2C_FUNCS, &funcs) < 0) {
     const int err = errno;
@@ -79,15 +84,21 @@ bool I2cDevBus::check_adapter(int fd, const std::string& path, IoctlFn ioctl_fn,
     }
     return false;
   }
-  if ((funcs & I2C_FUNC_I2C) == 0) {
-    if (error) {
-      *error = path +
-               " supports SMBus only, not the combined I2C transfers (I2C_RDWR) this backend needs; "
-               "use a bus whose adapter reports I2C in i2cdetect -F";
-    }
-    return false;
+  if ((funcs & I2C_FUNC_I2C) != 0) {
+    if (mode) *mode = I2cTransferMode::kI2c;
+    return true;
   }
-  return true;
+  constexpr unsigned long kSmbusNeeds = I2C_FUNC_SMBUS_READ_I2C_BLOCK | I2C_FUNC_SMBUS_WRITE_BYTE_DATA;
+  if ((funcs & kSmbusNeeds) == kSmbusNeeds) {
+    if (mode) *mode = I2cTransferMode::kSmbus;
+    return true;
+  }
+  if (error) {
+    *error = path +
+             " can do neither plain I2C transfers (I2C_RDWR) nor SMBus I2C-block reads with byte-data writes, which "
+             "this backend needs to read register bursts; use another bus (i2cdetect -F shows what each adapter does)";
+  }
+  return false;
 }
 
 std::unique_ptr<I2cDevBus> I2cDevBus::open(const std::string& path_or_number, I2cRetryPolicy policy,
@@ -99,19 +110,22 @@ std::unique_ptr<I2cDevBus> I2cDevBus::open(const std::string& path_or_number, I2
     if (error) *error = describe_open_failure(path, err);
     return nullptr;
   }
-  if (!check_adapter(fd, path, &system_ioctl, error)) {
+  I2cTransferMode mode = I2cTransferMode::kI2c;
+  if (!check_adapter(fd, path, &system_ioctl, &mode, error)) {
     ::close(fd);
     return nullptr;
   }
-  return adopt(fd, path, policy, &system_ioctl);
+  return adopt(fd, path, policy, &system_ioctl, mode);
 }
 
-std::unique_ptr<I2cDevBus> I2cDevBus::adopt(int fd, std::string name, I2cRetryPolicy policy, IoctlFn ioctl_fn) {
-  return std::unique_ptr<I2cDevBus>(new I2cDevBus(fd, std::move(name), policy, ioctl_fn ? ioctl_fn : &system_ioctl));
+std::unique_ptr<I2cDevBus> I2cDevBus::adopt(int fd, std::string name, I2cRetryPolicy policy, IoctlFn ioctl_fn,
+                                            I2cTransferMode mode) {
+  return std::unique_ptr<I2cDevBus>(
+      new I2cDevBus(fd, std::move(name), policy, ioctl_fn ? ioctl_fn : &system_ioctl, mode));
 }
 
-I2cDevBus::I2cDevBus(int fd, std::string name, I2cRetryPolicy policy, IoctlFn ioctl_fn)
-    : fd_(fd), name_(std::move(name)), policy_(policy), ioctl_(ioctl_fn) {
+I2cDevBus::I2cDevBus(int fd, std::string name, I2cRetryPolicy policy, IoctlFn ioctl_fn, I2cTransferMode mode)
+    : fd_(fd), name_(std::move(name)), policy_(policy), ioctl_(ioctl_fn), mode_(mode) {
   if (policy_.attempts < 1) policy_.attempts = 1;
 }
 
@@ -126,20 +140,20 @@ void I2cDevBus::set_error(const char* fmt, ...) noexcept {
   va_end(ap);
 }
 
-HalStatus I2cDevBus::transfer(void* rdwr, unsigned nmsgs, std::uint8_t address, std::uint8_t reg,
+HalStatus I2cDevBus::transfer(unsigned long request, void* arg, int ok_rc, std::uint8_t address, std::uint8_t reg,
                               const char* op) noexcept {
   int failures = 0;
   for (int attempt = 1; attempt <= policy_.attempts; ++attempt) {
-    const int rc = ioctl_(fd_, I2C_RDWR, rdwr);
-    if (rc == static_cast<int>(nmsgs)) {
+    const int rc = ioctl_(fd_, request, arg);
+    if (rc == ok_rc) {
       retries_ += failures;
       return HalStatus::kOk;
     }
     if (rc >= 0) {
       // The adapter stopped part-way without an errno; what the device saw
       // is unknown, so retrying a write could repeat a side effect.
-      set_error("%s: %s addr 0x%02x reg 0x%02x: short transfer (%d of %u messages)", name_.c_str(), op, address,
-                reg, rc, nmsgs);
+      set_error("%s: %s addr 0x%02x reg 0x%02x: short transfer (%d of %d messages)", name_.c_str(), op, address,
+                reg, rc, ok_rc);
       return HalStatus::kIoError;
     }
     const int err = errno;
@@ -163,6 +177,11 @@ HalStatus I2cDevBus::read_registers(std::uint8_t address, std::uint8_t reg, std:
               kMaxRead);
     return HalStatus::kIoError;
   }
+  if (mode_ == I2cTransferMode::kSmbus) {
+    const HalStatus s = smbus_read(address, reg, n);
+    if (s == HalStatus::kOk) std::memcpy(buf, rx_, static_cast<std::size_t>(n));
+    return s;
+  }
   std::uint8_t reg_byte = reg;
   i2c_msg msgs[2];
   msgs[0].addr = address;
@@ -174,7 +193,7 @@ HalStatus I2cDevBus::read_registers(std::uint8_t address, std::uint8_t reg, std:
   msgs[1].len = static_cast<__u16>(n);
   msgs[1].buf = rx_;
   i2c_rdwr_ioctl_data data{msgs, 2};
-  const HalStatus s = transfer(&data, 2, address, reg, "read");
+  const HalStatus s = transfer(I2C_RDWR, &data, 2, address, reg, "read");
   if (s == HalStatus::kOk) std::memcpy(buf, rx_, static_cast<std::size_t>(n));
   return s;
 }
@@ -184,6 +203,14 @@ HalStatus I2cDevBus::write_register(std::uint8_t address, std::uint8_t reg, std:
     set_error("%s: write addr 0x%02x reg 0x%02x: not a 7-bit address", name_.c_str(), address, reg);
     return HalStatus::kIoError;
   }
+  if (mode_ == I2cTransferMode::kSmbus) {
+    const HalStatus s = select_address(address, reg, "write");
+    if (s != HalStatus::kOk) return s;
+    i2c_smbus_data data{};
+    data.byte = value;
+    i2c_smbus_ioctl_data args{I2C_SMBUS_WRITE, reg, I2C_SMBUS_BYTE_DATA, &data};
+    return transfer(I2C_SMBUS, &args, 0, address, reg, "write");
+  }
   std::uint8_t bytes[2] = {reg, value};
   i2c_msg msg;
   msg.addr = address;
@@ -191,7 +218,43 @@ HalStatus I2cDevBus::write_register(std::uint8_t address, std::uint8_t reg, std:
   msg.len = 2;
   msg.buf = bytes;
   i2c_rdwr_ioctl_data data{&msg, 1};
-  return transfer(&data, 1, address, reg, "write");
+  return transfer(I2C_RDWR, &data, 1, address, reg, "write");
+}
+
+HalStatus I2cDevBus::select_address(std::uint8_t address, std::uint8_t reg, const char* op) noexcept {
+  if (selected_address_ == address) return HalStatus::kOk;
+  if (ioctl_(fd_, I2C_SLAVE, reinterpret_cast<void*>(static_cast<unsigned long>(address))) < 0) {
+    const int err = errno;
+    // EBUSY: a kernel driver owns the address (the IIO mpu6050 driver, say);
+    // I2C_RDWR would not have noticed, SMBus transfers go through the client.
+    set_error("%s: %s addr 0x%02x reg 0x%02x: selecting the address (I2C_SLAVE) failed: %s%s", name_.c_str(), op,
+              address, reg, ErrnoText(err).text,
+              err == EBUSY ? "; a kernel driver has claimed it: unbind that driver (see /sys/bus/i2c/devices)" : "");
+    return map_errno(err);
+  }
+  selected_address_ = address;
+  return HalStatus::kOk;
+}
+
+HalStatus I2cDevBus::smbus_read(std::uint8_t address, std::uint8_t reg, int n) noexcept {
+  HalStatus s = select_address(address, reg, "read");
+  for (int done = 0; s == HalStatus::kOk && done < n;) {
+    const int chunk = n - done < kSmbusBlockMax ? n - done : kSmbusBlockMax;
+    const auto chunk_reg = static_cast<std::uint8_t>(reg + done);
+    i2c_smbus_data data{};
+    data.block[0] = static_cast<__u8>(chunk);
+    i2c_smbus_ioctl_data args{I2C_SMBUS_READ, chunk_reg, I2C_SMBUS_I2C_BLOCK_DATA, &data};
+    s = transfer(I2C_SMBUS, &args, 0, address, chunk_reg, "read");
+    if (s != HalStatus::kOk) break;
+    if (data.block[0] != chunk) {
+      set_error("%s: read addr 0x%02x reg 0x%02x: the adapter returned %d of %d bytes", name_.c_str(), address,
+                chunk_reg, data.block[0], chunk);
+      return HalStatus::kIoError;
+    }
+    std::memcpy(rx_ + done, &data.block[1], static_cast<std::size_t>(chunk));
+    done += chunk;
+  }
+  return s;
 }
 
 }  // namespace rtfuse::hal

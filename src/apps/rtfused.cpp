@@ -144,6 +144,10 @@ int main(int argc, char** argv) {
       return 1;
     }
     buses = linux_hal->buses();
+    const std::string lines = linux_hal->describe();
+    for (std::size_t at = 0, nl; (nl = lines.find('\n', at)) != std::string::npos; at = nl + 1) {
+      std::fprintf(stderr, "rtfused: %s\n", lines.substr(at, nl - at).c_str());
+    }
   } else if (cfg.hardware.backend == rtfuse::HalBackend::kSim) {
     // The embedded config's scenario is the embedded demo drive.
     const std::string_view demo = rtfuse::apps::kEmbeddedDemoScenario;

@@ -82,4 +82,15 @@ std::unique_ptr<LinuxHal> LinuxHal::open(const RuntimeConfig& cfg, std::string* 
   return h;
 }
 
+std::string LinuxHal::describe() const {
+  const Devices& d = *devices_;
+  std::string out;
+  if (d.can) out += "CAN bus " + d.can->name() + ": SocketCAN raw, kernel receive stamps\n";
+  if (d.i2c) out += "IMU bus " + d.i2c->name() + ": " + hal::to_string(d.i2c->mode()) + "\n";
+  if (d.drdy) out += "IMU data-ready: GPIO rising edges, kernel-stamped\n";
+  if (d.i2c && !d.drdy) out += "IMU data-ready: none, polled at the sample rate\n";
+  if (d.video) out += "camera: V4L2 mmap streaming\n";
+  return out;
+}
+
 }  // namespace rtfuse

@@ -16,6 +16,10 @@ class LinuxHal {
   static std::unique_ptr<LinuxHal> open(const RuntimeConfig& cfg, std::string* error);
   ~LinuxHal();
   HalBuses buses() const { return buses_; }
+  // One line per opened bus and how it is driven ("IMU bus /dev/i2c-1: SMBus
+  // (I2C block reads, byte writes)"), for the start-up log: an SMBus-only
+  // adapter works but reads long bursts in pieces, which the user should know.
+  std::string describe() const;
 
  private:
   LinuxHal();

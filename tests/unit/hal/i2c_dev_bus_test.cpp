@@ -32,6 +32,13 @@ struct Call {
   unsigned long request;
   std::uint32_t nmsgs;
   Msg msgs[2];
+  // I2C_SLAVE: the address; I2C_SMBUS: the transaction.
+  unsigned long slave;
+  std::uint8_t smbus_read_write;
+  std::uint8_t smbus_command;
+  std::uint32_t smbus_size;
+  std::uint8_t smbus_len;   // block[0] as sent (I2C block)
+  std::uint8_t smbus_byte;  // data.byte as sent (byte data write)
 };
 constexpr int kShort = -1;  // script entry: report one message fewer than asked
 constexpr int kMaxCalls = 64;
@@ -41,6 +48,7 @@ int ncalls = 0;
 int script[kMaxCalls];  // errno per call, 0 = success; past the end: success
 int nscript = 0;
 bool fill_on_failure = false;  // scribble into the read buffer even when failing
+bool short_block = false;      // an I2C block read answers one byte fewer than asked
 unsigned long funcs = 0;
 int funcs_errno = 0;
 
@@ -48,6 +56,7 @@ void reset() {
   ncalls = 0;
   nscript = 0;
   fill_on_failure = false;
+  short_block = false;
   funcs = 0;
   funcs_errno = 0;
 }
@@ -73,6 +82,29 @@ int ioctl(int fd, unsigned long request, void* arg) {
   c = Call{};
   c.fd = fd;
   c.request = request;
+  const int e = idx < nscript ? script[idx] : 0;
+  if (request == I2C_SLAVE) {
+    c.slave = reinterpret_cast<unsigned long>(arg);
+    if (e == 0) return 0;
+    errno = e;
+    return -1;
+  }
+  if (request == I2C_SMBUS) {
+    auto* args = static_cast<i2c_smbus_ioctl_data*>(arg);
+    c.smbus_read_write = args->read_write;
+    c.smbus_command = args->command;
+    c.smbus_size = args->size;
+    c.smbus_len = args->data->block[0];
+    c.smbus_byte = args->data->byte;
+    const bool block_read = args->read_write == I2C_SMBUS_READ && args->size == I2C_SMBUS_I2C_BLOCK_DATA;
+    if (block_read && (e == 0 || fill_on_failure)) {
+      for (int b = 0; b < args->data->block[0]; ++b) args->data->block[1 + b] = pattern(args->command + b);
+      if (short_block) args->data->block[0] = static_cast<__u8>(args->data->block[0] - 1);
+    }
+    if (e == 0) return 0;
+    errno = e;
+    return -1;
+  }
   auto* data = static_cast<i2c_rdwr_ioctl_data*>(arg);
   c.nmsgs = data->nmsgs;
   for (std::uint32_t i = 0; i < data->nmsgs && i < 2; ++i) {
@@ -84,7 +116,6 @@ int ioctl(int fd, unsigned long request, void* arg) {
       for (int b = 0; b < 2 && b < m.len; ++b) c.msgs[i].bytes[b] = m.buf[b];
     }
   }
-  const int e = idx < nscript ? script[idx] : 0;
   if (e == 0 || fill_on_failure) {
     for (std::uint32_t i = 0; i < data->nmsgs; ++i) {
       if (data->msgs[i].flags & I2C_M_RD) {
@@ -106,11 +137,12 @@ class I2cDevBusTest : public ::testing::Test {
     fd_ = ::open("/dev/null", O_RDWR | O_CLOEXEC);
     ASSERT_GE(fd_, 0);
   }
-  std::unique_ptr<I2cDevBus> make(int attempts = 3) {
+  std::unique_ptr<I2cDevBus> make(int attempts = 3, I2cTransferMode mode = I2cTransferMode::kI2c) {
     I2cRetryPolicy p;
     p.attempts = attempts;
-    return I2cDevBus::adopt(fd_, "/dev/i2c-test", p, &fake::ioctl);
+    return I2cDevBus::adopt(fd_, "/dev/i2c-test", p, &fake::ioctl, mode);
   }
+  std::unique_ptr<I2cDevBus> make_smbus(int attempts = 3) { return make(attempts, I2cTransferMode::kSmbus); }
   int fd_ = -1;  // owned by the bus once adopted
 };
 
@@ -169,22 +201,39 @@ TEST(I2cDevBusOpen, OtherErrnoGivesTextWithoutGuessedFix) {
             "cannot open I2C bus /dev/i2c-1: Device or resource busy");
 }
 
-TEST(I2cDevBusOpen, CheckAdapterAcceptsPlainI2c) {
+TEST(I2cDevBusOpen, CheckAdapterPrefersPlainI2c) {
   fake::reset();
   fake::funcs = I2C_FUNC_I2C | I2C_FUNC_SMBUS_EMUL;
   std::string error;
-  EXPECT_TRUE(I2cDevBus::check_adapter(3, "/dev/i2c-1", &fake::ioctl, &error));
+  I2cTransferMode mode = I2cTransferMode::kSmbus;
+  EXPECT_TRUE(I2cDevBus::check_adapter(3, "/dev/i2c-1", &fake::ioctl, &mode, &error));
+  EXPECT_EQ(mode, I2cTransferMode::kI2c);
   EXPECT_EQ(error, "");
 }
 
-TEST(I2cDevBusOpen, CheckAdapterRejectsSmbusOnly) {
+TEST(I2cDevBusOpen, CheckAdapterFallsBackToSmbusOnSmbusOnlyAdapters) {
   fake::reset();
-  fake::funcs = I2C_FUNC_SMBUS_EMUL;
+  // What i2c-stub reports by default.
+  fake::funcs = I2C_FUNC_SMBUS_QUICK | I2C_FUNC_SMBUS_BYTE | I2C_FUNC_SMBUS_BYTE_DATA | I2C_FUNC_SMBUS_WORD_DATA |
+                I2C_FUNC_SMBUS_I2C_BLOCK;
   std::string error;
-  EXPECT_FALSE(I2cDevBus::check_adapter(3, "/dev/i2c-1", &fake::ioctl, &error));
+  I2cTransferMode mode = I2cTransferMode::kI2c;
+  EXPECT_TRUE(I2cDevBus::check_adapter(3, "/dev/i2c-1", &fake::ioctl, &mode, &error));
+  EXPECT_EQ(mode, I2cTransferMode::kSmbus);
+  EXPECT_STREQ(to_string(mode), "SMBus (I2C block reads, byte writes)");
+  EXPECT_STREQ(to_string(I2cTransferMode::kI2c), "I2C (combined I2C_RDWR transfers)");
+}
+
+TEST(I2cDevBusOpen, CheckAdapterRejectsAdaptersWithoutBlockReads) {
+  fake::reset();
+  fake::funcs = I2C_FUNC_SMBUS_BYTE_DATA | I2C_FUNC_SMBUS_WORD_DATA;
+  std::string error;
+  I2cTransferMode mode = I2cTransferMode::kI2c;
+  EXPECT_FALSE(I2cDevBus::check_adapter(3, "/dev/i2c-1", &fake::ioctl, &mode, &error));
   EXPECT_EQ(error,
-            "/dev/i2c-1 supports SMBus only, not the combined I2C transfers (I2C_RDWR) this backend needs; use a bus "
-            "whose adapter reports I2C in i2cdetect -F");
+            "/dev/i2c-1 can do neither plain I2C transfers (I2C_RDWR) nor SMBus I2C-block reads with byte-data "
+            "writes, which this backend needs to read register bursts; use another bus (i2cdetect -F shows what "
+            "each adapter does)");
 }
 
 // --- transfers ------------------------------------------------------------------
@@ -229,6 +278,116 @@ TEST_F(I2cDevBusTest, WriteIsOneMessageOfRegisterAndValue) {
   EXPECT_EQ(c.msgs[0].len, 2);
   EXPECT_EQ(c.msgs[0].bytes[0], 0x6B);
   EXPECT_EQ(c.msgs[0].bytes[1], 0x80);
+}
+
+// --- SMBus mode (SMBus-only adapters) ---------------------------------------------
+
+TEST_F(I2cDevBusTest, SmbusReadIsOneI2cBlockReadAfterSelectingTheAddress) {
+  auto bus = make_smbus();
+  EXPECT_EQ(bus->mode(), I2cTransferMode::kSmbus);
+  std::uint8_t buf[14] = {};
+  ASSERT_EQ(bus->read_registers(0x68, 0x3B, buf, 14), HalStatus::kOk);
+  ASSERT_EQ(fake::ncalls, 2);
+  EXPECT_EQ(fake::calls[0].request, static_cast<unsigned long>(I2C_SLAVE));
+  EXPECT_EQ(fake::calls[0].slave, 0x68u);
+  const fake::Call& c = fake::calls[1];
+  EXPECT_EQ(c.request, static_cast<unsigned long>(I2C_SMBUS));
+  EXPECT_EQ(c.smbus_read_write, I2C_SMBUS_READ);
+  EXPECT_EQ(c.smbus_command, 0x3B);
+  EXPECT_EQ(c.smbus_size, static_cast<std::uint32_t>(I2C_SMBUS_I2C_BLOCK_DATA));
+  EXPECT_EQ(c.smbus_len, 14);
+  for (int i = 0; i < 14; ++i) EXPECT_EQ(buf[i], fake::pattern(0x3B + i)) << i;
+  // The address stays selected: the next transfer to it is one call.
+  ASSERT_EQ(bus->read_registers(0x68, 0x75, buf, 1), HalStatus::kOk);
+  EXPECT_EQ(fake::ncalls, 3);
+  EXPECT_EQ(fake::calls[2].request, static_cast<unsigned long>(I2C_SMBUS));
+  // Another device is selected first.
+  ASSERT_EQ(bus->read_registers(0x0C, 0x00, buf, 1), HalStatus::kOk);
+  ASSERT_EQ(fake::ncalls, 5);
+  EXPECT_EQ(fake::calls[3].slave, 0x0Cu);
+}
+
+TEST_F(I2cDevBusTest, SmbusReadsLongerThan32BytesAreSplitAtSuccessiveRegisters) {
+  auto bus = make_smbus();
+  std::uint8_t buf[64] = {};
+  ASSERT_EQ(bus->read_registers(0x68, 0x10, buf, 40), HalStatus::kOk);
+  ASSERT_EQ(fake::ncalls, 3);
+  EXPECT_EQ(fake::calls[1].smbus_command, 0x10);
+  EXPECT_EQ(fake::calls[1].smbus_len, 32);
+  EXPECT_EQ(fake::calls[2].smbus_command, 0x30);
+  EXPECT_EQ(fake::calls[2].smbus_len, 8);
+  for (int i = 0; i < 40; ++i) EXPECT_EQ(buf[i], fake::pattern(0x10 + i)) << i;
+  EXPECT_EQ(buf[40], 0);
+}
+
+TEST_F(I2cDevBusTest, SmbusWriteIsByteData) {
+  auto bus = make_smbus();
+  ASSERT_EQ(bus->write_register(0x68, 0x6B, 0x80), HalStatus::kOk);
+  ASSERT_EQ(fake::ncalls, 2);
+  const fake::Call& c = fake::calls[1];
+  EXPECT_EQ(c.request, static_cast<unsigned long>(I2C_SMBUS));
+  EXPECT_EQ(c.smbus_read_write, I2C_SMBUS_WRITE);
+  EXPECT_EQ(c.smbus_command, 0x6B);
+  EXPECT_EQ(c.smbus_size, static_cast<std::uint32_t>(I2C_SMBUS_BYTE_DATA));
+  EXPECT_EQ(c.smbus_byte, 0x80);
+}
+
+TEST_F(I2cDevBusTest, SmbusNacksAreRetriedAndFailuresLeaveTheBufferAlone) {
+  auto bus = make_smbus(3);
+  fake::set_script({0, ENXIO, 0});  // select, NACK, success
+  std::uint8_t buf[2] = {};
+  ASSERT_EQ(bus->read_registers(0x68, 0x41, buf, 2), HalStatus::kOk);
+  EXPECT_EQ(bus->retries(), 1);
+  fake::ncalls = 0;
+  fake::set_script({ENXIO, ENXIO, ENXIO});
+  fake::fill_on_failure = true;
+  buf[0] = 7;
+  EXPECT_EQ(bus->read_registers(0x68, 0x41, buf, 2), HalStatus::kNack);
+  EXPECT_EQ(fake::ncalls, 3);
+  EXPECT_EQ(buf[0], 7);
+  EXPECT_STREQ(bus->last_error(),
+               "/dev/i2c-test: read addr 0x68 reg 0x41 failed on attempt 3 of 3: No such device or address (no acknowledge (NACK))");
+}
+
+TEST_F(I2cDevBusTest, SmbusShortBlockIsAnIoError) {
+  auto bus = make_smbus();
+  fake::short_block = true;
+  std::uint8_t buf[14] = {};
+  EXPECT_EQ(bus->read_registers(0x68, 0x3B, buf, 14), HalStatus::kIoError);
+  EXPECT_STREQ(bus->last_error(), "/dev/i2c-test: read addr 0x68 reg 0x3b: the adapter returned 13 of 14 bytes");
+  EXPECT_EQ(buf[0], 0);
+}
+
+TEST_F(I2cDevBusTest, SmbusAddressClaimedByAKernelDriverSaysSo) {
+  auto bus = make_smbus();
+  fake::set_script({EBUSY});
+  std::uint8_t buf[1] = {};
+  EXPECT_EQ(bus->read_registers(0x68, 0x75, buf, 1), HalStatus::kIoError);
+  EXPECT_STREQ(bus->last_error(),
+               "/dev/i2c-test: read addr 0x68 reg 0x75: selecting the address (I2C_SLAVE) failed: Device or resource "
+               "busy; a kernel driver has claimed it: unbind that driver (see /sys/bus/i2c/devices)");
+  // Not selected: the next call tries again.
+  ASSERT_EQ(bus->read_registers(0x68, 0x75, buf, 1), HalStatus::kOk);
+  EXPECT_EQ(fake::calls[1].request, static_cast<unsigned long>(I2C_SLAVE));
+}
+
+TEST_F(I2cDevBusTest, SmbusSteadyStateTransfersDoNotAllocate) {
+  auto bus = make_smbus(3);
+  std::uint8_t buf[14] = {};
+  fake::set_script({0, ENXIO, 0});
+  (void)bus->read_registers(0x68, 0x3B, buf, 14);
+  fake::ncalls = 0;
+  fake::set_script({ENXIO, 0, ETIMEDOUT, 0});
+  std::size_t allocations = 0;
+  {
+    rtfuse::test::AllocScope scope;
+    for (int i = 0; i < 100; ++i) {
+      (void)bus->read_registers(0x68, 0x3B, buf, 14);
+      (void)bus->write_register(0x68, 0x6B, static_cast<std::uint8_t>(i));
+    }
+    allocations = scope.count();
+  }
+  EXPECT_EQ(allocations, 0u);
 }
 
 struct ErrnoCase {
