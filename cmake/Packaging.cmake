@@ -10,7 +10,7 @@
 # the packed programs (packaging/deb-depends.cmake), so a static libstdc++
 # (the cross toolchain's default) drops libstdc++6 and a native build keeps it.
 
-set(RTFUSE_PACKAGE_PROGRAMS rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot)
+set(RTFUSE_PACKAGE_PROGRAMS rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot rtfuse-canopen-node)
 foreach(prog IN LISTS RTFUSE_PACKAGE_PROGRAMS)
   if(NOT TARGET ${prog})
     message(FATAL_ERROR "Packaging: program target '${prog}' does not exist (src/apps)")
@@ -101,7 +101,7 @@ string(CONCAT CPACK_PACKAGE_DESCRIPTION
   "rtfused fuses wheel encoders on SocketCAN and an MPU-6050 IMU on i2c-dev\n"
   "in a fixed-rate real-time loop and publishes odometry over LCM. Includes\n"
   "the rtfused.service systemd unit, rtfuse-replay, rtfuse-sim,\n"
-  "rtfuse-camera-snapshot, example configs in /etc/rtfuse, the LCM types as\n"
+  "rtfuse-camera-snapshot, rtfuse-canopen-node, example configs in /etc/rtfuse, the LCM types as\n"
   "a jar and Python modules.")
 set(CPACK_STRIP_FILES ON)
 set(CPACK_DEBIAN_PACKAGE_ARCHITECTURE ${RTFUSE_DEB_ARCH})

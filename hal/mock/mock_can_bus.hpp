@@ -18,20 +18,29 @@
 
 namespace rtfuse::hal::mock {
 
-class MockCanBus;
+// Where a device model's frames go: the mock bus's receive queue, or a real
+// CAN interface when the same model runs as a stand-alone node on a wire
+// (rtfuse-canopen-node). False when the frame could not be sent.
+class CanWire {
+ public:
+  virtual ~CanWire() = default;
+  // `stamp` is when the device sent it: a heartbeat that fell due between two
+  // looks at the clock carries its due time. A real wire stamps on its own.
+  virtual bool transmit(const CanFrame& frame, TimeNs stamp) noexcept = 0;
+};
 
-// A device on the virtual bus (see canopen_node.hpp). Nodes answer by calling
-// bus.inject() / bus.inject_at(); they do not see each other's frames, only
+// A device on the virtual bus (see sim/devices/canopen_encoder_node.hpp).
+// Nodes answer through the wire; they do not see each other's frames, only
 // the ones the host sends, which is all a device model under test needs.
 class CanNode {
  public:
   virtual ~CanNode() = default;
   // A frame the host sent; `now` is the bus time of transmission.
-  virtual void on_frame(const CanFrame& frame, TimeNs now, MockCanBus& bus) noexcept = 0;
+  virtual void on_frame(const CanFrame& frame, TimeNs now, CanWire& wire) noexcept = 0;
   // Bus time moved to `now`: emit whatever became due (heartbeats...). Must be
   // idempotent for repeated calls with the same `now`: the bus calls it
   // whenever it looks at the time.
-  virtual void advance(TimeNs now, MockCanBus& bus) noexcept = 0;
+  virtual void advance(TimeNs now, CanWire& wire) noexcept = 0;
 };
 
 struct MockCanBusCapacity {
@@ -40,7 +49,7 @@ struct MockCanBusCapacity {
   int nodes = 16;
 };
 
-class MockCanBus final : public CanBus {
+class MockCanBus final : public CanBus, public CanWire {
  public:
   // With a clock, bus time is clock->now(); without one it is set_time()'s.
   explicit MockCanBus(MockCanBusCapacity capacity = {}, const Clock* clock = nullptr);
@@ -73,6 +82,8 @@ class MockCanBus final : public CanBus {
   // Same, with an explicit stamp: a node emitting a heartbeat that fell due
   // between two looks at the clock stamps it with its due time.
   bool inject_at(const CanFrame& frame, TimeNs stamp) noexcept;
+  // CanWire: what the attached nodes send is queued like inject_at().
+  bool transmit(const CanFrame& frame, TimeNs stamp) noexcept override { return inject_at(frame, stamp); }
   int pending() const noexcept { return rx_count_; }
   std::int64_t rx_dropped() const noexcept { return rx_dropped_; }
 

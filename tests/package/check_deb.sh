@@ -66,7 +66,7 @@ need() {  # need PATH [TYPE-TEST]
   local p=$1 t=${2:--f}
   test "$t" "$d/$p" || bad "missing /$p"
 }
-for prog in rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot; do need "usr/bin/$prog" -x; done
+for prog in rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot rtfuse-canopen-node; do need "usr/bin/$prog" -x; done
 expected_etc=()
 for f in "$src"/config/*.toml; do expected_etc+=("etc/rtfuse/$(basename "$f")"); done
 for f in "$src"/config/scenarios/*.toml; do expected_etc+=("etc/rtfuse/scenarios/$(basename "$f")"); done
@@ -108,9 +108,9 @@ case "$arch" in
 esac
 mapfile -t elves < <(cd "$d" && find . -type f -print0 | xargs -0 -r file -N --mime-type |
   awk -F': ' '$2 ~ /application\/x-(pie-)?(executable|sharedlib|object)/ {print substr($1, 3)}' | sort)
-expected_elves=$'usr/bin/rtfuse-camera-snapshot\nusr/bin/rtfuse-replay\nusr/bin/rtfuse-sim\nusr/bin/rtfused'
+expected_elves=$'usr/bin/rtfuse-camera-snapshot\nusr/bin/rtfuse-canopen-node\nusr/bin/rtfuse-replay\nusr/bin/rtfuse-sim\nusr/bin/rtfused'
 [[ $(printf '%s\n' "${elves[@]}") == "$expected_elves" ]] ||
-  bad "ELF files are [${elves[*]}], expected exactly usr/bin/rtfuse-camera-snapshot rtfuse-replay rtfuse-sim rtfused (no test or bench programs)"
+  bad "ELF files are [${elves[*]}], expected exactly usr/bin/rtfuse-camera-snapshot rtfuse-canopen-node rtfuse-replay rtfuse-sim rtfused (no test or bench programs)"
 for e in "${elves[@]}"; do
   m=$(LC_ALL=C readelf -h "$d/$e" | awk -F': +' '/Machine:/ {print $2}')
   [[ -z $machine || $m == "$machine" ]] || bad "/$e is for '$m', not $arch ($machine)"

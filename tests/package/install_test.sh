@@ -9,7 +9,7 @@
 #     (multi-user.target.wants) and not started;
 #   - every NEEDED library of the programs comes from a package in Depends;
 #   - rtfused --version, the other programs' --help (rtfuse-replay,
-#     rtfuse-sim, rtfuse-camera-snapshot), the shipped rtfused.toml loading (it then stops at
+#     rtfuse-sim, rtfuse-camera-snapshot, rtfuse-canopen-node), the shipped rtfused.toml loading (it then stops at
 #     the missing CAN bus), a 2 s simulated run as user rtfuse, and
 #     rtfuse-sim driving scenarios/straight.toml within the bounds of
 #     tests/integration/sim_drives.py;
@@ -143,7 +143,7 @@ wants=$work/etc/systemd/system/multi-user.target.wants/rtfused.service
 # --- libraries: each NEEDED one from a package in Depends ----------------
 depends=$(in_root dpkg-query -W -f='${Depends}' rtfuse)
 dep_names=$(tr ',' '\n' <<<"$depends" | sed -E 's/^ +//; s/[ (:].*//' | sort -u)
-for prog in rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot; do
+for prog in rtfused rtfuse-replay rtfuse-sim rtfuse-camera-snapshot rtfuse-canopen-node; do
   while read -r so; do
     owner=""
     for dir in "/lib/$triplet" "/usr/lib/$triplet" /lib /usr/lib; do
@@ -161,7 +161,7 @@ done
 out=$(in_root /usr/bin/rtfused --version) || die "rtfused --version failed in the $arch root: $out"
 [[ $out == "rtfused $version" ]] || die "rtfused --version printed '$out', expected 'rtfused $version'"
 note "rtfused --version: $out"
-for prog in rtfuse-replay rtfuse-sim rtfuse-camera-snapshot; do
+for prog in rtfuse-replay rtfuse-sim rtfuse-camera-snapshot rtfuse-canopen-node; do
   in_root "/usr/bin/$prog" --help >/dev/null || die "$prog --help failed in the $arch root"
 done
 

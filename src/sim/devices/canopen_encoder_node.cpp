@@ -91,7 +91,7 @@ void CanopenEncoderNode::set_stuck(bool stuck, TimeNs now) noexcept {
   stuck_ = stuck;
 }
 
-void CanopenEncoderNode::boot(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+void CanopenEncoderNode::boot(TimeNs now, hal::mock::CanWire& wire) noexcept {
   booted_ = true;
   ++boot_count_;
   state_ = canopen::NmtState::kPreOperational;
@@ -100,11 +100,11 @@ void CanopenEncoderNode::boot(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
   f.id = canopen::kHeartbeatBase + config_.node_id;
   f.dlc = 1;
   f.data[0] = static_cast<std::uint8_t>(canopen::NmtState::kBootUp);
-  bus.inject_at(f, now);
+  wire.transmit(f, now);
 }
 
 bool CanopenEncoderNode::emit_emcy(std::uint16_t error_code, std::uint8_t error_register,
-                                   const std::uint8_t manufacturer[5], TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+                                   const std::uint8_t manufacturer[5], TimeNs now, hal::mock::CanWire& wire) noexcept {
   if (silent_ || !booted_ || state_ == canopen::NmtState::kStopped) return false;
   hal::CanFrame f;
   f.id = canopen::kEmcyBase + config_.node_id;
@@ -113,10 +113,10 @@ bool CanopenEncoderNode::emit_emcy(std::uint16_t error_code, std::uint8_t error_
   f.data[1] = static_cast<std::uint8_t>(error_code >> 8);
   f.data[2] = error_register;
   for (int i = 0; i < 5; ++i) f.data[3 + i] = manufacturer != nullptr ? manufacturer[i] : 0;
-  return bus.inject_at(f, now);
+  return wire.transmit(f, now);
 }
 
-void CanopenEncoderNode::send_tpdo(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+void CanopenEncoderNode::send_tpdo(TimeNs now, hal::mock::CanWire& wire) noexcept {
   hal::CanFrame f;
   f.id = config_.tpdo_cob_id;
   f.dlc = config_.tpdo_dlc;
@@ -124,10 +124,10 @@ void CanopenEncoderNode::send_tpdo(TimeNs now, hal::mock::MockCanBus& bus) noexc
   for (int i = 0; i < config_.position_width; ++i) {
     f.data[config_.position_offset + i] = static_cast<std::uint8_t>(raw >> (8 * i));
   }
-  if (bus.inject_at(f, now)) ++tpdo_count_;
+  if (wire.transmit(f, now)) ++tpdo_count_;
 }
 
-void CanopenEncoderNode::handle_nmt(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+void CanopenEncoderNode::handle_nmt(const hal::CanFrame& frame, TimeNs now, hal::mock::CanWire& wire) noexcept {
   // CiA 301 NMT node control is exactly two bytes; stacks drop anything else.
   if (frame.dlc != 2) return;
   const std::uint8_t target = frame.data[1];
@@ -140,30 +140,30 @@ void CanopenEncoderNode::handle_nmt(const hal::CanFrame& frame, TimeNs now, hal:
     case canopen::kNmtResetCommunication:
       // Both end in a fresh boot-up. The encoder's position is physics, not an
       // application parameter, so it survives a reset node.
-      boot(now, bus);
+      boot(now, wire);
       break;
     default: break;
   }
 }
 
-void CanopenEncoderNode::on_frame(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+void CanopenEncoderNode::on_frame(const hal::CanFrame& frame, TimeNs now, hal::mock::CanWire& wire) noexcept {
   if (silent_ || !booted_ || frame.extended || frame.rtr || frame.error) return;
-  advance(now, bus);  // a heartbeat due before this frame goes out first
+  advance(now, wire);  // a heartbeat due before this frame goes out first
   if (frame.id == canopen::kNmtCobId) {
-    handle_nmt(frame, now, bus);
+    handle_nmt(frame, now, wire);
   } else if (frame.id == canopen::kSyncCobId) {
-    if (state_ == canopen::NmtState::kOperational) send_tpdo(now, bus);
+    if (state_ == canopen::NmtState::kOperational) send_tpdo(now, wire);
   }
 }
 
-void CanopenEncoderNode::advance(TimeNs now, hal::mock::MockCanBus& bus) noexcept {
+void CanopenEncoderNode::advance(TimeNs now, hal::mock::CanWire& wire) noexcept {
   if (!base_time_set_) {
     base_time_ = now;
     base_time_set_ = true;
   }
   if (silent_) return;
   if (!booted_) {
-    boot(now, bus);
+    boot(now, wire);
     return;
   }
   const TimeNs period = config_.heartbeat_period_ns;
@@ -178,7 +178,7 @@ void CanopenEncoderNode::advance(TimeNs now, hal::mock::MockCanBus& bus) noexcep
     f.id = canopen::kHeartbeatBase + config_.node_id;
     f.dlc = 1;
     f.data[0] = static_cast<std::uint8_t>(state_);
-    bus.inject_at(f, next_heartbeat_);
+    wire.transmit(f, next_heartbeat_);
     next_heartbeat_ += period;
     ++emitted;
   }

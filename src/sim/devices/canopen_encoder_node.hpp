@@ -1,5 +1,6 @@
 #pragma once
-// A CiA 301 / CiA 406 rotary encoder as a device on a hal::mock::MockCanBus, behaving
+// A CiA 301 / CiA 406 rotary encoder as a device on a hal::mock::MockCanBus (or, through
+// rtfuse-canopen-node, on a real CAN interface), behaving
 // the way a real one does on the wire, so the encoder driver can be tested
 // (and a simulated robot driven) without hardware:
 //
@@ -91,7 +92,7 @@ class CanopenEncoderNode final : public hal::mock::CanNode {
   void jump(std::int64_t counts) noexcept { offset_ += counts; }
   // Sends an EMCY now. False when silent, stopped or not yet booted.
   bool emit_emcy(std::uint16_t error_code, std::uint8_t error_register, const std::uint8_t manufacturer[5],
-                 TimeNs now, hal::mock::MockCanBus& bus) noexcept;
+                 TimeNs now, hal::mock::CanWire& wire) noexcept;
 
   // --- inspection -------------------------------------------------------------
   canopen::NmtState nmt_state() const noexcept { return state_; }
@@ -104,14 +105,14 @@ class CanopenEncoderNode final : public hal::mock::CanNode {
   bool valid() const noexcept { return valid_; }
 
   // --- hal::mock::CanNode ----------------------------------------------------------------
-  void on_frame(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept override;
-  void advance(TimeNs now, hal::mock::MockCanBus& bus) noexcept override;
+  void on_frame(const hal::CanFrame& frame, TimeNs now, hal::mock::CanWire& wire) noexcept override;
+  void advance(TimeNs now, hal::mock::CanWire& wire) noexcept override;
 
  private:
-  void boot(TimeNs now, hal::mock::MockCanBus& bus) noexcept;
+  void boot(TimeNs now, hal::mock::CanWire& wire) noexcept;
   void rebase(TimeNs now) noexcept;
-  void handle_nmt(const hal::CanFrame& frame, TimeNs now, hal::mock::MockCanBus& bus) noexcept;
-  void send_tpdo(TimeNs now, hal::mock::MockCanBus& bus) noexcept;
+  void handle_nmt(const hal::CanFrame& frame, TimeNs now, hal::mock::CanWire& wire) noexcept;
+  void send_tpdo(TimeNs now, hal::mock::CanWire& wire) noexcept;
 
   CanopenEncoderConfig config_;
   bool valid_ = true;

@@ -13,6 +13,7 @@ using rtfuse::hal::CanBusState;
 using rtfuse::hal::CanFrame;
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::mock::CanNode;
+using rtfuse::hal::mock::CanWire;
 using rtfuse::hal::mock::MockCanBus;
 using rtfuse::hal::mock::MockCanBusCapacity;
 
@@ -34,17 +35,17 @@ class EchoNode final : public CanNode {
   int frames_seen = 0;
   int advances = 0;
   CanFrame last{};
-  void on_frame(const CanFrame& f, TimeNs, MockCanBus& bus) noexcept override {
+  void on_frame(const CanFrame& f, TimeNs now, CanWire& wire) noexcept override {
     ++frames_seen;
     last = f;
-    bus.inject(frame(f.id + 1, f.data[0]));
+    wire.transmit(frame(f.id + 1, f.data[0]), now);
   }
-  void advance(TimeNs now, MockCanBus& bus) noexcept override {
+  void advance(TimeNs now, CanWire& wire) noexcept override {
     ++advances;
     if (period_ <= 0) return;
     if (next_ == 0) next_ = now + period_;
     while (next_ <= now) {
-      bus.inject_at(frame(0x7FF, 0xAA), next_);
+      wire.transmit(frame(0x7FF, 0xAA), next_);
       next_ += period_;
     }
   }
