@@ -210,9 +210,11 @@ int main(int argc, char** argv) {
   }
 
   const rtfuse::TimeNs now = clock.now();
-  std::printf("{\"interface\": \"%s\", \"seconds\": %.3f, \"frames_heard\": %lld, \"syncs\": %lld, \"sent\": %lld, "
+  // start_ns (CLOCK_MONOTONIC) lets a test on the same machine place the
+  // fault windows on its own clock.
+  std::printf("{\"interface\": \"%s\", \"start_ns\": %lld, \"seconds\": %.3f, \"frames_heard\": %lld, \"syncs\": %lld, \"sent\": %lld, "
               "\"send_failures\": %lld, \"nodes\": [",
-              ifname.c_str(), static_cast<double>(now - t0) / 1e9, frames_heard, syncs, wire.sent, wire.failed);
+              ifname.c_str(), static_cast<long long>(t0), static_cast<double>(now - t0) / 1e9, frames_heard, syncs, wire.sent, wire.failed);
   for (std::size_t i = 0; i < nodes.size(); ++i) {
     const auto& n = nodes[i];
     std::printf("%s{\"id\": %d, \"state\": %d, \"boots\": %d, \"tpdos\": %lld, \"counts\": %lld}", i ? ", " : "",
