@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstdio>
 
 #include "runtime/camera_calibration.hpp"
 
@@ -38,6 +39,8 @@ std::unique_ptr<CameraDevice> CameraDevice::create(const CameraBuses& buses, Fus
   if (vo.enabled) dcfg.max_frames_per_step = std::max(1, c.buffers);
   std::unique_ptr<CameraDevice> d(new CameraDevice(core, device_slot, vo_slot));
   d->clock_ = buses.clock;
+  // Five frame periods, and never under 200 ms (USB hiccups at 100 fps).
+  d->stall_after_ns_ = std::max<TimeNs>(5 * 1'000'000'000LL / std::max(1, c.fps), 200'000'000);
   d->pool_ = std::make_unique<FramePool>(c.pool_frames, dcfg.calibration.width, dcfg.calibration.height);
   d->camera_ = drivers::StereoCamera::create(dcfg, *buses.video, *buses.clock, *d->pool_, error);
   if (!d->camera_) {
@@ -135,6 +138,14 @@ void CameraDevice::fill_snapshot(Snapshot& s) noexcept {
       d.level = st.rectified == 0 ? DeviceLevel::kStale : DeviceLevel::kWarn;
       break;
     default: d.level = DeviceLevel::kWarn; break;
+  }
+  const TimeNs since = s.tick_time_ns - st.rate_last_stamp;
+  if (st.rectified > 0 && st.rate_last_stamp > 0 && since > stall_after_ns_ && d.level == DeviceLevel::kOk) {
+    d.level = DeviceLevel::kWarn;
+    d.state = "stalled";
+    char text[96];
+    std::snprintf(text, sizeof text, "no frame for %lld ms", static_cast<long long>(since / 1'000'000));
+    set_device_message(d.message, text);
   }
 }
 

@@ -66,6 +66,11 @@ class CameraDevice final : public ThreadDevice {
   FusionCore& core_;
   hal::Clock* clock_ = nullptr;
   int slot_ = -1;
+  // No frame for this long on the loop's clock and the camera is reported
+  // stalled, whatever its thread last said: a device that stops delivering
+  // without the driver noticing (a stall shorter than the dequeue timeout
+  // each time, a thread that hangs) still shows.
+  TimeNs stall_after_ns_ = 0;
   int vo_slot_ = -1;
   int vo_sensor_ = -1;
   std::unique_ptr<VisualOdometry> vo_;

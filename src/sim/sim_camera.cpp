@@ -71,4 +71,10 @@ std::uint32_t SimCamera::fill(TimeNs stamp, std::uint32_t sequence, std::uint8_t
   return format_.image_size;
 }
 
+void SimCamera::stall_until(TimeNs until) noexcept {
+  // The frames due before `until` are never exposed: the next one is the
+  // first of the camera's own cadence after the stall.
+  if (until > next_) next_ += (until - next_ + period_ - 1) / period_ * period_;
+}
+
 }  // namespace rtfuse::sim

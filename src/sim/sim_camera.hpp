@@ -28,6 +28,11 @@ class SimCamera final : public hal::mock::FrameSource {
                                            TimeNs t0, std::uint64_t seed, std::string* error);
 
   hal::VideoStream& stream() { return *stream_; }
+  // Fault injection (unplug, refused reopens): drive it from the camera's thread.
+  hal::mock::MockVideoStream& mock_stream() { return *stream_; }
+  // The sensor stops delivering until `until` (a USB stall, a hung ISP): the
+  // frames due meanwhile are never captured; 0 ends a stall at once.
+  void stall_until(TimeNs until) noexcept;
   // Capture time of the next frame: what the lockstep drive steps the camera thread up to.
   TimeNs next_frame_time() noexcept override { return next_; }
   std::uint32_t fill(TimeNs stamp, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override;

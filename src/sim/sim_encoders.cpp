@@ -93,8 +93,33 @@ void SimEncoders::update(TimeNs now) noexcept {
   }
   const TruthState s = truth_.truth_at(ns_to_sec(now - t0_));
   for (int w = 0; w < wheel_count_; ++w) {
-    nodes_[w]->set_position(wrap_position(wheel_counts(robot_, s, w), robot_.encoder_bits, robot_.encoder_signed), now);
+    const std::int64_t counts = stuck_[w] ? stuck_value_[w] : wheel_counts(robot_, s, w) + offset_[w];
+    nodes_[w]->set_position(wrap_position(counts, robot_.encoder_bits, robot_.encoder_signed), now);
   }
+}
+
+void SimEncoders::set_silent(int wheel, bool silent, TimeNs now) noexcept {
+  if (wheel < 0 || wheel >= wheel_count_) return;
+  update(now);
+  nodes_[wheel]->set_silent(silent, now);
+}
+
+void SimEncoders::set_stuck(int wheel, bool stuck, TimeNs now) noexcept {
+  if (wheel < 0 || wheel >= wheel_count_ || stuck == stuck_[wheel]) return;
+  const std::int64_t truth_counts = wheel_counts(robot_, truth_.truth_at(ns_to_sec(now - t0_)), wheel);
+  if (stuck) {
+    stuck_value_[wheel] = truth_counts + offset_[wheel];
+  } else {
+    offset_[wheel] = stuck_value_[wheel] - truth_counts;  // counts on from the held value
+  }
+  stuck_[wheel] = stuck;
+  update(now);
+}
+
+void SimEncoders::jump(int wheel, std::int64_t counts) noexcept {
+  if (wheel < 0 || wheel >= wheel_count_) return;
+  offset_[wheel] += counts;
+  if (stuck_[wheel]) stuck_value_[wheel] += counts;
 }
 
 hal::HalStatus SimEncoders::send(const hal::CanFrame& frame) noexcept {

@@ -53,6 +53,15 @@ class SimEncoders final : public hal::CanBus {
   // Times each node was power-cycled back after a dropout.
   int reboots(int wheel) const noexcept { return reboots_[wheel]; }
 
+  // --- faults (the fault-matrix tests drive these from the lockstep loop) -----
+  // The wheel's node is off the bus (cable cut) or back on it, without a reboot.
+  void set_silent(int wheel, bool silent, TimeNs now) noexcept;
+  // The wheel's counter holds its value from `now` on; released, it counts on
+  // from where it stopped (a slipping magnet, a frozen encoder ASIC).
+  void set_stuck(int wheel, bool stuck, TimeNs now) noexcept;
+  // The wheel's counter jumps by `counts` and stays off by that much.
+  void jump(int wheel, std::int64_t counts) noexcept;
+
   // --- hal::CanBus ------------------------------------------------------------
   hal::HalStatus send(const hal::CanFrame& frame) noexcept override;
   int receive(hal::CanFrame* out, int max, TimeNs timeout_ns, hal::HalStatus* status) noexcept override;
@@ -74,6 +83,10 @@ class SimEncoders final : public hal::CanBus {
   hal::mock::MockCanBus bus_;
   std::unique_ptr<sim::CanopenEncoderNode> nodes_[kMaxSimWheels];
   int reboots_[kMaxSimWheels] = {};
+  // Counts added to the truth's, and the value a stuck counter holds.
+  std::int64_t offset_[kMaxSimWheels] = {};
+  bool stuck_[kMaxSimWheels] = {};
+  std::int64_t stuck_value_[kMaxSimWheels] = {};
   DropoutEdge edges_[2 * kMaxDropouts];
   int edge_count_ = 0;
   int next_edge_ = 0;

@@ -115,13 +115,28 @@ hal::HalStatus SimImu::wait_edge(TimeNs timeout_ns, hal::GpioEdge* out) noexcept
       return hal::HalStatus::kTimeout;
     }
     clock_.sleep_until(t);
-    const ImuSample s = sample(next_);
+    ImuSample s = sample(next_);
+    for (int i = 0; i < 3; ++i) {
+      s.accel_mps2[i] += disturbance_accel_[i];
+      s.gyro_rad_s[i] += disturbance_gyro_[i];
+    }
     ++next_;
     if (chip_.set_sample(s.accel_mps2, s.gyro_rad_s, s.temperature_c)) {
+      if (edges_lost_) {
+        ++lost_edges_;
+        continue;
+      }
       ++edges_;
       if (out != nullptr) *out = hal::GpioEdge{t, true};
       return hal::HalStatus::kOk;
     }
+  }
+}
+
+void SimImu::set_disturbance(const double accel_mps2[3], const double gyro_rad_s[3]) noexcept {
+  for (int i = 0; i < 3; ++i) {
+    disturbance_accel_[i] = accel_mps2[i];
+    disturbance_gyro_[i] = gyro_rad_s[i];
   }
 }
 

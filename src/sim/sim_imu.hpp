@@ -67,6 +67,15 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource {
   // scenario's rate whatever the driver wrote, so a mismatch is worth a log line.
   const char* config_mismatch() const noexcept;
 
+  // --- faults (the fault-matrix tests drive these from the lockstep loop) -----
+  // Added to every sample from now on, in the IMU frame (an impact, a
+  // vibration burst); zeros end it.
+  void set_disturbance(const double accel_mps2[3], const double gyro_rad_s[3]) noexcept;
+  // While on, samples are latched into the registers but their data-ready
+  // edges are lost (a broken interrupt wire, a GPIO misconfigured).
+  void set_edges_lost(bool lost) noexcept { edges_lost_ = lost; }
+  std::int64_t edges_lost() const noexcept { return lost_edges_; }
+
   sim::MpuRegisterFile& chip() noexcept { return chip_; }
   const sim::MpuRegisterFile& chip() const noexcept { return chip_; }
   hal::mock::MockI2cBus& bus() noexcept { return bus_; }
@@ -99,6 +108,10 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource {
   std::int64_t next_ = 0;
   std::int64_t skipped_ = 0;
   std::int64_t edges_ = 0;
+  double disturbance_accel_[3] = {};
+  double disturbance_gyro_[3] = {};
+  bool edges_lost_ = false;
+  std::int64_t lost_edges_ = 0;
 };
 
 }  // namespace rtfuse::sim

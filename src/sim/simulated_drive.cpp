@@ -69,18 +69,32 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
     // Let the writer catch up: in lockstep nothing may be lost.
     while (tap && tap->recorder().backlogged()) std::this_thread::sleep_for(std::chrono::microseconds(200));
     clock.set(t);
+    if (options.before_tick) {
+      options.before_tick(t, *robot);
+      clock.set(t);
+    }
     // Each device thread's events up to this tick, as it would have handled
     // them before the loop woke. Bounded: a driver that is down (re-init
     // backing off) does not wait, and the event time would not move.
     for (int d = 0; d < pipeline->thread_device_count(); ++d) {
       ThreadDevice& device = pipeline->thread_device(d);
-      for (int k = 0; k < 64 && robot->next_event_time(device.name()) <= t; ++k) device.step(kDeviceStepTimeoutNs);
+      for (int k = 0; k < 64; ++k) {
+        const TimeNs due = robot->next_event_time(device.name());
+        if (due > t) break;
+        device.step(kDeviceStepTimeoutNs);
+        clock.set(t);
+        // No progress (the device is down, its driver backing off between
+        // reopens): once per tick, as its thread would wake about once per
+        // tick; more would run the backoff on a clock that cannot advance.
+        if (robot->next_event_time(device.name()) == due) break;
+      }
       clock.set(t);
     }
     ++loop.ticks;
     pipeline->step(t, loop, output);
     const Snapshot& snap = pipeline->core().last_snapshot();
     const TruthState truth = robot->truth_at(t);
+    if (options.after_tick) options.after_tick(t, snap, truth);
     if (t >= next_truth) {
       next_truth += truth_period;
       int size = 0;

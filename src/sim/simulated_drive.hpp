@@ -11,14 +11,23 @@
 
 #include "runtime/config.hpp"
 #include "runtime/snapshot.hpp"
+#include "sim/truth_trajectory.hpp"
 
 namespace rtfuse::sim {
+
+class SimulatedRobot;
 
 struct DriveOptions {
   std::string scenario_path;  // empty: the config's [hardware] scenario
   std::string record_path;    // empty: no recording
   std::string config_text;    // stored in the recording
   double truth_rate_hz = 50.0;
+  // Called at every tick time t before the devices and the loop run up to
+  // it: the fault-matrix tests inject faults into the robot's devices here
+  // (everything runs on this one thread in lockstep).
+  std::function<void(TimeNs t, SimulatedRobot& robot)> before_tick;
+  // Called after the loop's tick at t with what it published and the truth.
+  std::function<void(TimeNs t, const Snapshot& snapshot, const TruthState& truth)> after_tick;
 };
 
 struct DriveResult {
