@@ -12,9 +12,17 @@
 #                  damaged copies of the log that must be rejected)
 #   zero_alloc     rtfused --record under LD_PRELOAD=alloc_probe: no heap allocation in
 #                  steady state, in any thread (after the probe's self-test)
+#   live_soak      rtfused on the simulated robot with every sensor at a 1 kHz loop
+#                  for SOAK_SECONDS (120) under the probe: nothing allocated in steady
+#                  state, resident memory flat after a 20 s warm-up (sampled every
+#                  5 s, growth <= 64 KiB), overruns counted and reported
+#   disk_full      rtfused --record onto a 1 MiB tmpfs (a private mount namespace):
+#                  the loop runs on to --duration, the write error is named at exit
+#                  (exit 1), and the cut recording replays with --allow-truncated
+#                  (REPLAY) and is refused without it
 #
 # NAME=VALUE settings (passed by tests/system/CMakeLists.txt):
-#   PYTHON CHECK TOOLS_DIR JAVA CLASSPATH_DECODE PROBE PROBE_SELFTEST
+#   PYTHON CHECK TOOLS_DIR JAVA CLASSPATH_DECODE PROBE PROBE_SELFTEST CONFIG_DIR SOAK_SECONDS
 #
 # Exit: 0 pass, 1 fail, 77 skipped (no network namespace and
 # RTFUSE_SKIP_NETNS=1, or no JVM for jvm_decode).
@@ -29,15 +37,15 @@ if [[ $# -lt 3 ]]; then
 fi
 mode=$1 outdir=$2 rtfused=$3
 shift 3
-PYTHON=/usr/bin/python3 CHECK= TOOLS_DIR= JAVA= CLASSPATH_DECODE= PROBE= PROBE_SELFTEST=
+PYTHON=/usr/bin/python3 CHECK= TOOLS_DIR= JAVA= CLASSPATH_DECODE= PROBE= PROBE_SELFTEST= CONFIG_DIR= SOAK_SECONDS=120 REPLAY=
 for kv in "$@"; do
   case "$kv" in
-    PYTHON=* | CHECK=* | TOOLS_DIR=* | JAVA=* | CLASSPATH_DECODE=* | PROBE=* | PROBE_SELFTEST=*)
+    PYTHON=* | CHECK=* | TOOLS_DIR=* | JAVA=* | CLASSPATH_DECODE=* | PROBE=* | PROBE_SELFTEST=* | CONFIG_DIR=* | SOAK_SECONDS=* | REPLAY=*)
       printf -v "${kv%%=*}" '%s' "${kv#*=}" ;;
     *) echo "$0: unknown setting '$kv'" >&2; exit 2 ;;
   esac
 done
-case "$mode" in udp_multicast | jvm_decode | zero_alloc) ;; *) echo "$0: unknown mode '$mode'" >&2; exit 2 ;; esac
+case "$mode" in udp_multicast | jvm_decode | zero_alloc | live_soak | disk_full) ;; *) echo "$0: unknown mode '$mode'" >&2; exit 2 ;; esac
 
 say() { echo "[$mode] $*"; }
 die() { echo "[$mode] FAIL: $*"; exit 1; }
@@ -71,7 +79,7 @@ if [[ "${RTFUSE_SYSTEM_TEST_IN_NETNS:-}" != "1" ]]; then
   mkdir -p "$outdir"
   RTFUSE_SYSTEM_TEST_IN_NETNS=1 exec "${unshare_cmd[@]}" -- "$BASH" "$0" "$mode" "$outdir" "$rtfused" \
     PYTHON="$PYTHON" CHECK="$CHECK" TOOLS_DIR="$TOOLS_DIR" JAVA="$JAVA" CLASSPATH_DECODE="$CLASSPATH_DECODE" \
-    PROBE="$PROBE" PROBE_SELFTEST="$PROBE_SELFTEST"
+    PROBE="$PROBE" PROBE_SELFTEST="$PROBE_SELFTEST" CONFIG_DIR="$CONFIG_DIR" SOAK_SECONDS="$SOAK_SECONDS" REPLAY="$REPLAY"
 fi
 
 # ---------------------------------------------------------------------------
@@ -84,7 +92,7 @@ cleanup() {
 trap cleanup EXIT
 
 ip link set lo up || die "ip link set lo up failed"
-ip route add 224.0.0.0/4 dev lo || die "ip route add 224.0.0.0/4 dev lo failed"
+ip route replace 224.0.0.0/4 dev lo || die "ip route replace 224.0.0.0/4 dev lo failed"
 # Safety: this namespace must hold nothing but lo, so nothing can leave it.
 links=$(ip -o link show | awk -F': ' '{print $2}' | tr '\n' ' ')
 [[ "$links" == "lo " ]] || die "not a private network namespace (links: $links); refusing to send multicast"
@@ -187,6 +195,76 @@ case "$mode" in
       die "rtfused allocates on the heap in steady state"
     }
     [[ $rc -eq 0 ]] || die "rtfused under the allocation probe exited with status $rc"
+    ;;
+  disk_full)
+    [[ -x "$REPLAY" ]] || die "rtfuse-replay not found: $REPLAY"
+    # Its own mount namespace: the small tmpfs is seen by this run only.
+    if [[ "${RTFUSE_DISK_FULL_IN_MNTNS:-}" != "1" ]]; then
+      RTFUSE_DISK_FULL_IN_MNTNS=1 exec unshare -m -- "$BASH" "$0" "$mode" "$outdir" "$rtfused" REPLAY="$REPLAY"
+    fi
+    disk="$outdir/disk"
+    mkdir -p "$disk"
+    mount -t tmpfs -o size=1m tmpfs "$disk" || die "cannot mount a 1 MiB tmpfs on $disk"
+    rc=0
+    "$rtfused" --duration 4 --quiet --lcm-url memq:// --record "$disk/rec.lcm" \
+      >"$outdir/rtfused.stdout" 2>"$outdir/rtfused.stderr" || rc=$?
+    show "$outdir/rtfused.stderr" "rtfused stderr"
+    say "rtfused exit status $rc; $(grep -m1 '^rtfused: ran ' "$outdir/rtfused.stdout" || echo 'no run summary')"
+    ((rc == 1)) || die "rtfused recording onto a full disk exited $rc, expected 1"
+    grep -q "recording $disk/rec.lcm: .*No space left on device" "$outdir/rtfused.stderr" ||
+      die "rtfused did not name the full disk (ENOSPC) and the file"
+    # The loop was not held up by the writer: ~4 s of 200 Hz ticks.
+    ticks=$(sed -nE 's/^rtfused: ran .* ([0-9]+) ticks.*/\1/p' "$outdir/rtfused.stdout")
+    [[ -n $ticks ]] && ((ticks >= 700)) || die "the loop ran ${ticks:-no} ticks in 4 s at 200 Hz (>= 700 expected)"
+    rrc=0
+    "$REPLAY" -l "$disk/rec.lcm" >"$outdir/replay.out" 2>&1 || rrc=$?
+    ((rrc == 1)) && grep -q "truncated after event" "$outdir/replay.out" ||
+      { cat "$outdir/replay.out"; die "rtfuse-replay of the cut recording: exit $rrc without naming the truncation"; }
+    "$REPLAY" -l "$disk/rec.lcm" --allow-truncated >"$outdir/replay-allowed.out" 2>&1 ||
+      { cat "$outdir/replay-allowed.out"; die "rtfuse-replay --allow-truncated failed on the cut recording"; }
+    say "cut recording: $(grep -m1 -o 'truncated after event [0-9]*' "$outdir/replay.out"), replays with --allow-truncated"
+    umount "$disk"
+    ;;
+
+  live_soak)
+    [[ -f "$PROBE" ]] || die "alloc probe not found: $PROBE"
+    [[ -f "$CONFIG_DIR/sim.toml" ]] || die "no config/sim.toml under CONFIG_DIR=$CONFIG_DIR"
+    # config/sim.toml (every sensor, the camera and VO included) with a 1 kHz
+    # loop; its relative paths (calibration, scenario) need the directory.
+    cp -r "$CONFIG_DIR" "$outdir/config"
+    sed -i -E 's/^frequency = [0-9]+/frequency = 1000/' "$outdir/config/sim.toml"
+    grep -q '^frequency = 1000' "$outdir/config/sim.toml" || die "could not set the loop to 1 kHz in sim.toml"
+    RTFUSE_ALLOC_REPORT="$outdir/rtfused.report" LD_PRELOAD="$PROBE" \
+      "$rtfused" --config "$outdir/config/sim.toml" --duration "$SOAK_SECONDS" --quiet --lcm-url "$URL" \
+      >"$outdir/rtfused.stdout" 2>"$outdir/rtfused.stderr" &
+    daemon=$!
+    pids+=("$daemon")
+    : >"$outdir/rss.txt"
+    for ((s = 0; s <= SOAK_SECONDS; s += 5)); do
+      rss=$(awk '/^VmRSS:/ {print $2}' "/proc/$daemon/status" 2>/dev/null) || break
+      [[ -n $rss ]] || break
+      echo "$s $rss" >>"$outdir/rss.txt"
+      sleep 5
+    done
+    rc=0
+    wait "$daemon" || rc=$?
+    show "$outdir/rtfused.stderr" "rtfused stderr"
+    show "$outdir/rtfused.stdout" "rtfused stdout"
+    say "rtfused exit status $rc; resident memory (s KiB): $(tr '\n' ' ' <"$outdir/rss.txt")"
+    [[ $rc -eq 0 ]] || die "rtfused exited with status $rc"
+    "$PYTHON" "$CHECK" alloc "$outdir/rtfused.report" --rtfused-stdout "$outdir/rtfused.stdout" || {
+      echo "(raw report: $outdir/rtfused.report)"
+      die "rtfused allocates on the heap in steady state"
+    }
+    read -r warm growth samples < <(awk '$1 >= 20 { if (!n++) base = $2; if ($2 - base > g) g = $2 - base }
+                                         END { print base, g + 0, n + 0 }' "$outdir/rss.txt")
+    ((samples >= SOAK_SECONDS / 5 - 4)) || die "only $samples resident-memory samples after warm-up"
+    say "resident memory after warm-up: $warm KiB, largest growth $growth KiB over $samples samples"
+    ((growth <= 64)) || die "resident memory grew by $growth KiB after warm-up (limit 64 KiB)"
+    summary=$(grep -m1 '^rtfused: ran ' "$outdir/rtfused.stdout") || die "rtfused printed no run summary"
+    say "$summary"
+    ticks=$(sed -E 's/.* ([0-9]+) ticks.*/\1/' <<<"$summary")
+    ((ticks >= SOAK_SECONDS * 1000 / 2)) || die "only $ticks ticks in $SOAK_SECONDS s at 1 kHz: the loop fell far behind"
     ;;
 esac
 say "PASS"
