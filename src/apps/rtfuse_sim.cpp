@@ -5,9 +5,18 @@
 // ticks, the published outputs and the ground truth on its own channel.
 // rtfuse-replay replays such a file byte for byte; tools/plot_trajectory.py
 // draws it. Prints one JSON line with the errors against ground truth.
+//
+// --report-every S (the soak, tools/soak.sh): one JSON line per S simulated
+// seconds before the final one, with the process's resident memory, the
+// error, the largest variance and whether any state or covariance entry
+// was ever not finite, and the counters; under tools/soak.sh's allocation
+// probe the first report arms it (start-up is over) and the end disarms it.
+#include <fcntl.h>
 #include <unistd.h>
 
+#include <chrono>
 #include <cinttypes>
+#include <cmath>
 #include <cstdio>
 #include <cstring>
 #include <string>
@@ -17,8 +26,66 @@
 #include "runtime/config_loader.hpp"
 #include "sim/simulated_drive.hpp"
 
+extern "C" void rtfuse_alloc_probe_steady(int steady) __attribute__((weak));
+
 namespace {
 
+long resident_kib() {
+  // statm's second field is resident pages. open/read, not fopen: no FILE
+  // is allocated while the allocation probe is armed.
+  char buf[128];
+  const int fd = ::open("/proc/self/statm", O_RDONLY | O_CLOEXEC);
+  if (fd < 0) return -1;
+  const ssize_t n = ::read(fd, buf, sizeof buf - 1);
+  ::close(fd);
+  if (n <= 0) return -1;
+  buf[n] = 0;
+  long size = 0, resident = 0;
+  if (std::sscanf(buf, "%ld %ld", &size, &resident) != 2) return -1;
+  return resident * (sysconf(_SC_PAGESIZE) / 1024);
+}
+
+struct SoakReport {
+  double every_s = 0;
+  double next_s = 0;
+  double max_variance = 0;
+  double max_error = 0;
+  bool finite = true;
+  bool armed = false;
+  std::chrono::steady_clock::time_point wall0 = std::chrono::steady_clock::now();
+
+  void on_tick(rtfuse::TimeNs t, rtfuse::TimeNs t0, const rtfuse::Snapshot& s, const rtfuse::sim::TruthState& truth) {
+    for (int k = 0; k < 15; ++k) finite = finite && std::isfinite(s.state[k]);
+    for (int k = 0; k < 15; ++k) {
+      const double v = s.covariance[k * 16];
+      finite = finite && std::isfinite(v);
+      if (v > max_variance) max_variance = v;
+    }
+    const double e = s.initialized ? std::hypot(s.state[0] - truth.x, s.state[1] - truth.y) : 0.0;
+    if (e > max_error) max_error = e;
+    const double sim_s = static_cast<double>(t - t0) / 1e9;
+    if (sim_s < next_s) return;
+    next_s += every_s;
+    std::int64_t received = 0, accepted = 0, rejected = 0;
+    for (int i = 0; i < s.num_sensors; ++i) {
+      received += s.sensors[i].received;
+      accepted += s.sensors[i].accepted;
+      rejected += rtfuse::rejected_total(s.sensors[i]);
+    }
+    const double wall = std::chrono::duration<double>(std::chrono::steady_clock::now() - wall0).count();
+    std::printf("{\"report\": 1, \"sim_s\": %.1f, \"wall_s\": %.1f, \"rss_kib\": %ld, \"error_m\": %.4f, "
+                "\"max_error_m\": %.4f, \"position_sigma_m\": %.4f, \"max_variance\": %.6g, \"finite\": %s, "
+                "\"ticks\": %" PRId64 ", \"fused\": %" PRId64 ", \"received\": %" PRId64 ", \"accepted\": %" PRId64
+                ", \"rejected\": %" PRId64 "}\n",
+                sim_s, wall, resident_kib(), e, max_error, std::sqrt(s.covariance[0] + s.covariance[16]), max_variance,
+                finite ? "true" : "false", s.loop.ticks, s.loop.measurements_fused, received, accepted, rejected);
+    std::fflush(stdout);
+    if (!armed && rtfuse_alloc_probe_steady != nullptr) {
+      rtfuse_alloc_probe_steady(1);
+      armed = true;
+    }
+  }
+};
 
 }  // namespace
 
@@ -26,10 +93,13 @@ int main(int argc, char** argv) {
   CLI::App app{"rtfuse-sim: drive the simulated robot in lockstep and record the drive at HAL level"};
   std::string config_path, scenario_path, out_path;
   bool quiet = false;
+  double report_every = 0;
   app.add_option("-c,--config", config_path, "robot config (TOML) with [hardware] backend = \"sim\"")->required();
   app.add_option("-s,--scenario", scenario_path, "drive scenario (default: the config's [hardware] scenario)");
   app.add_option("-o,--out", out_path, "write the drive to this LCM log (a HAL recording)");
   app.add_flag("-q,--quiet", quiet, "no progress line");
+  app.add_option("--report-every", report_every, "a JSON line every S simulated seconds (the soak; 0: none)")
+      ->check(CLI::NonNegativeNumber);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -55,11 +125,22 @@ int main(int argc, char** argv) {
   options.scenario_path = scenario_path;
   options.record_path = out_path;
   options.config_text = text;
+  SoakReport soak;
+  soak.every_s = report_every;
+  soak.next_s = report_every;
+  rtfuse::TimeNs t0 = -1;
+  if (report_every > 0) {
+    options.after_tick = [&](rtfuse::TimeNs t, const rtfuse::Snapshot& s, const rtfuse::sim::TruthState& truth) {
+      if (t0 < 0) t0 = t;
+      soak.on_tick(t, t0, s, truth);
+    };
+  }
   const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
   const rtfuse::sim::DriveResult r =
       rtfuse::sim::run_simulated_drive(cfg, options, [tty](const rtfuse::sim::DriveProgress& p) {
         if (tty) std::fprintf(stderr, "\rsim: %.0f of %.0f s\033[K", p.sim_time_s, p.duration_s);
       });
+  if (soak.armed) rtfuse_alloc_probe_steady(0);
   if (tty) std::fprintf(stderr, "\n");
   if (!r.ok) {
     std::fprintf(stderr, "rtfuse-sim: %s\n", r.error.c_str());

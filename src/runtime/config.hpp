@@ -102,6 +102,9 @@ struct RuntimeConfig {
   // Largest input message taken from LCM; larger ones are dropped undecoded
   // and counted (every input type is well under 1 KiB with short frame names).
   int lcm_max_message_bytes = 4096;
+  // An LCM input stamped more than this after its arrival is dropped
+  // (counted as invalid): [lcm] max_stamp_ahead, seconds.
+  TimeNs lcm_max_stamp_ahead_ns = 500'000'000;
   RealtimeConfig realtime;
   PublishConfig publish;
   std::array<SensorConfig, kMaxSensors> sensors{};

@@ -118,8 +118,13 @@ void read_realtime(const Section& s, RealtimeConfig& rt) {
 }
 
 void read_lcm(const Section& s, RuntimeConfig& cfg) {
-  s.reject_unknown({"url", "max_message_bytes"});
+  s.reject_unknown({"url", "max_message_bytes", "max_stamp_ahead"});
   read_int(s, "max_message_bytes", cfg.lcm_max_message_bytes, 256, 1 << 20);
+  double ahead_s = static_cast<double>(cfg.lcm_max_stamp_ahead_ns) / 1e9;
+  if (read_number(s, "max_stamp_ahead", ahead_s, [](double v) { return v >= 0.001 && v <= 3600.0; },
+                  "must be 0.001 .. 3600 s")) {
+    cfg.lcm_max_stamp_ahead_ns = static_cast<TimeNs>(std::llround(ahead_s * 1e9));
+  }
   std::string& url_out = cfg.lcm_url;
   std::string url;
   if (!s.read("url", url)) return;

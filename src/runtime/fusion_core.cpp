@@ -180,6 +180,7 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
     st.rejected_overflow = c.overflow.load(std::memory_order_relaxed);
     st.rejected_rate = c.rate_limited.load(std::memory_order_relaxed);
     st.rejected_oversize = c.oversize.load(std::memory_order_relaxed);
+    st.rejected_invalid += c.ahead.load(std::memory_order_relaxed);
     s.sensors[i] = st;
   }
   s.num_devices = 0;

@@ -41,6 +41,13 @@ bool InputRouter::on_message(const char* channel, const std::uint8_t* data, int 
       c.decode_errors.fetch_add(1, std::memory_order_relaxed);
       return true;
     }
+    // A stamp ahead of the arrival by more than clock skew and jitter can
+    // explain would move the filter's time forward and make every honest
+    // sensor stale: a broken or hostile sender must not get that far.
+    if (scratch_.stamp - now > cfg_.lcm_max_stamp_ahead_ns) {
+      c.ahead.fetch_add(1, std::memory_order_relaxed);
+      return true;
+    }
     scratch_.sensor = static_cast<std::uint8_t>(i);
     if (!rings_[i]->try_push(scratch_)) c.overflow.fetch_add(1, std::memory_order_relaxed);
     return true;
@@ -56,6 +63,10 @@ bool InputRouter::on_message(const char* channel, const std::uint8_t* data, int 
     }
     SetPoseCommand cmd;
     if (decoder_.decode_set_pose(data, size, &cmd.pose, &cmd.stamp, &cmd.frame) != transport::DecodeResult::kOk) {
+      set_pose_errors_.fetch_add(1, std::memory_order_relaxed);
+      return true;
+    }
+    if (cmd.stamp - now > cfg_.lcm_max_stamp_ahead_ns) {
       set_pose_errors_.fetch_add(1, std::memory_order_relaxed);
       return true;
     }

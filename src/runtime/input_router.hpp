@@ -26,6 +26,7 @@ struct InputCounters {
   std::atomic<std::int64_t> overflow{0};
   std::atomic<std::int64_t> oversize{0};      // above [lcm] max_message_bytes, not decoded
   std::atomic<std::int64_t> rate_limited{0};  // beyond the sensor's max_rate, not decoded
+  std::atomic<std::int64_t> ahead{0};         // stamped further ahead of its arrival than [lcm] max_stamp_ahead
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 };
 

@@ -14,7 +14,7 @@ struct SensorStats {
   std::int64_t received = 0;
   std::int64_t accepted = 0;
   std::int64_t rejected_mahalanobis = 0;
-  std::int64_t rejected_invalid = 0;   // NaN/Inf, bad covariance, no transform, out of order
+  std::int64_t rejected_invalid = 0;   // NaN/Inf, bad covariance, no transform, out of order, stamped ahead
   std::int64_t rejected_stale = 0;     // older than the history
   std::int64_t rejected_overflow = 0;  // ring full: the loop fell behind
   std::int64_t rejected_rate = 0;      // beyond the sensor's max_rate, not decoded

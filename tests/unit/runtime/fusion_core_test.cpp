@@ -234,6 +234,56 @@ TEST(FusionCore, AFloodIsRateLimitedBeforeDecodingAndOversizeMessagesAreDropped)
   EXPECT_EQ(snap(*core).sensors[0].rejected_rate, 1000 - 21);
 }
 
+TEST(FusionCore, AStampFurtherAheadOfItsArrivalThanTheWindowIsDropped) {
+  // The daemon_input fuzzer's finding: one sender stamping in the future
+  // moved the filter's time on and made the honest sensors stale.
+  std::string err;
+  auto core = FusionCore::create(load(kTwoYawSources), &err);  // [lcm] max_stamp_ahead: 0.5 s by default
+  ASSERT_TRUE(core) << err;
+  const TimeNs t0 = 1'000'000'000;
+  auto honest = odometry(t0, 0.0, 1.0);
+  auto early = odometry(t0 + 500'000'000, 0.0, 1.0);        // at the window's edge: taken
+  auto future = odometry(t0 + 501'000'000 + 10'000'000, 0.0, 1.0);  // 1 ms beyond it: dropped
+  auto far = odometry(t0 + 3600LL * 1'000'000'000, 0.0, 1.0);
+  core->input().on_message("odom", honest.data(), static_cast<int>(honest.size()), t0);
+  core->input().on_message("odom", early.data(), static_cast<int>(early.size()), t0);
+  core->input().on_message("odom", future.data(), static_cast<int>(future.size()), t0 + 10'000'000);
+  core->input().on_message("odom", far.data(), static_cast<int>(far.size()), t0 + 10'000'000);
+  core->tick(t0 + 600'000'000, LoopStats{});
+  Snapshot s = snap(*core);
+  EXPECT_EQ(s.sensors[0].received, 4);
+  EXPECT_EQ(s.sensors[0].accepted, 2);
+  EXPECT_EQ(s.sensors[0].rejected_invalid, 2);
+  // The filter's time did not jump an hour: a message of now is still fused.
+  for (int i = 1; i <= 10; ++i) {
+    const TimeNs t = t0 + 600'000'000 + i * 10'000'000LL;
+    auto a = odometry(t, 0.0, 1.0);
+    core->input().on_message("odom", a.data(), static_cast<int>(a.size()), t);
+    core->tick(t, LoopStats{});
+  }
+  s = snap(*core);
+  EXPECT_EQ(s.sensors[0].accepted, 12);
+  EXPECT_EQ(s.sensors[0].rejected_stale, 0);
+}
+
+TEST(FusionCore, TheStampWindowIsConfigurable) {
+  std::string text = kTwoYawSources;
+  text = "[lcm]\nmax_stamp_ahead = 0.05\n" + text;
+  const RuntimeConfig cfg = load(text.c_str());
+  EXPECT_EQ(cfg.lcm_max_stamp_ahead_ns, 50'000'000);
+  std::string err;
+  auto core = FusionCore::create(cfg, &err);
+  ASSERT_TRUE(core) << err;
+  const TimeNs t0 = 1'000'000'000;
+  auto a = odometry(t0 + 60'000'000, 0.0, 1.0);
+  core->input().on_message("odom", a.data(), static_cast<int>(a.size()), t0);
+  core->tick(t0 + 100'000'000, LoopStats{});
+  EXPECT_EQ(snap(*core).sensors[0].rejected_invalid, 1);
+  const ConfigLoadResult bad = load_config_string("[lcm]\nmax_stamp_ahead = 0\n" + std::string(kTwoYawSources), "t.toml");
+  ASSERT_FALSE(bad.config);
+  EXPECT_NE(bad.errors[0].to_string().find("max_stamp_ahead"), std::string::npos) << bad.errors[0].to_string();
+}
+
 TEST(FusionCore, UnknownChannelIsCounted) {
   std::string err;
   auto core = FusionCore::create(load(kTwoYawSources), &err);
