@@ -137,6 +137,54 @@ def check_bad_messages(tmp):
     assert err < TOLERANCE
 
 
+def check_bad_stamps(tmp):
+    """Time going backwards and duplicate stamps (the fault matrix): on the
+    Jackal's wheel odometry, every 40th message stamped 1 s before the
+    previous one (dropped as out of order, as robot_localization drops a
+    message older than its topic's last) and every 45th sent twice with the
+    same stamp (taken twice, as robot_localization takes an equal stamp)."""
+    from rtfuse_tools import lcm_log
+    from rtfuse_tools.lcmtypes_path import import_lcmtypes
+    import_lcmtypes()
+    from rtfuse import odometry_t
+    log, cfg = prepare(tmp)
+    base = last_json(replay(cfg, log))
+    events = lcm_log.read_events(log)
+    out = os.path.join(tmp, "stamps.lcm")
+    n_back = n_dup = k = 0
+    last_utime = None
+    with lcm_log.LogWriter(out) as w:
+        for ev in events:
+            data = ev.data
+            if ev.channel == "/jackal_velocity_controller/odom":
+                k += 1
+                m = odometry_t.decode(data)
+                if k % 40 == 0 and last_utime is not None:
+                    m.header.utime = last_utime - 1_000_000
+                    data = m.encode()
+                    n_back += 1
+                else:
+                    last_utime = m.header.utime
+                w.write(ev.channel, data, ev.timestamp)
+                if k % 45 == 0 and k % 40 != 0:
+                    w.write(ev.channel, data, ev.timestamp)
+                    n_dup += 1
+                continue
+            w.write(ev.channel, data, ev.timestamp)
+    p = replay(cfg, out)
+    assert p.returncode == 0, p.stderr
+    r = last_json(p)
+    assert all(math.isfinite(r[k]) for k in ("x", "y", "z", "roll", "pitch", "yaw")), r
+    odom = r["sensors"]["odom0"]
+    assert odom["rejected_invalid"] == base["sensors"]["odom0"]["rejected_invalid"] + n_back, (odom, n_back)
+    assert odom["received"] == base["sensors"]["odom0"]["received"] + n_dup, (odom, n_dup)
+    err = math.dist((r["x"], r["y"], r["z"]), EXPECTED)
+    moved = math.dist((r["x"], r["y"], r["z"]), (base["x"], base["y"], base["z"]))
+    print(f"{n_back} odometry messages stamped 1 s back, all dropped as out of order; {n_dup} sent twice, taken; "
+          f"final position {moved:.4f} m from the clean replay's, {err:.3f} m from robot_localization's")
+    assert err < TOLERANCE
+
+
 def quat_mul(a, b):
     ax, ay, az, aw = a
     bx, by, bz, bw = b
@@ -222,7 +270,7 @@ def check_rotated_imu(tmp):
 
 
 CHECKS = {"rotated_imu": check_rotated_imu, "bag_parity": check_bag_parity, "deterministic": check_deterministic,
-          "bad_logs": check_bad_logs, "bad_messages": check_bad_messages}
+          "bad_logs": check_bad_logs, "bad_messages": check_bad_messages, "bad_stamps": check_bad_stamps}
 
 if __name__ == "__main__":
     if not os.path.exists(BAG):
