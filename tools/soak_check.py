@@ -6,6 +6,7 @@ report, the final result last); ALLOC_REPORT the allocation probe's report
 (armed at the first report); DISTANCE_M the path's length. Exit 0 when every check holds, 1 otherwise;
 prints the figures either way.
 """
+import argparse
 import json
 import sys
 
@@ -18,23 +19,25 @@ FINAL_ERROR_FRACTION = 0.01
 
 
 def main(argv):
-    if len(argv) != 4:
-        print(__doc__, file=sys.stderr)
-        return 2
+    ap = argparse.ArgumentParser(description="the verdict on a tools/soak.sh run (docs/reliability.md, Soak)")
+    ap.add_argument("report", help="rtfuse-sim --report-every's output (JSON lines, the final result last)")
+    ap.add_argument("alloc_report", help="the allocation probe's report (armed at the first report)")
+    ap.add_argument("distance_m", type=float, help="the length of the path driven, m")
+    args = ap.parse_args(argv[1:])
     reports, final = [], None
-    with open(argv[1]) as f:
+    with open(args.report) as f:
         for n, line in enumerate(f, 1):
             try:
                 obj = json.loads(line)
             except json.JSONDecodeError as e:
-                print(f"{argv[1]}:{n}: not JSON: {e}")
+                print(f"{args.report}:{n}: not JSON: {e}")
                 return 1
             if obj.get("report"):
                 reports.append(obj)
             else:
                 final = obj
     steady = None
-    with open(argv[2]) as f:
+    with open(args.alloc_report) as f:
         for line in f:
             if line.startswith("steady_allocations "):
                 steady = int(line.split()[1])
@@ -83,7 +86,7 @@ def main(argv):
     if final is not None:
         print(f"final: error {final['final_error_m']:.3f} m, RMS {final['rms_error_m']:.3f} m, yaw "
               f"{final['final_yaw_error_rad']:.4f} rad; raw wheel odometry {final['raw_final_error_m']:.3f} m")
-        distance = float(argv[3])
+        distance = args.distance_m
         print(f"distance driven: {distance / 1000:.1f} km; final error {100 * final['final_error_m'] / distance:.3f} % of it")
         if final["final_error_m"] > FINAL_ERROR_FRACTION * distance:
             failures.append(f"final error {final['final_error_m']:.3f} m above {100 * FINAL_ERROR_FRACTION:g} % of "

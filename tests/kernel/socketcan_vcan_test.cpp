@@ -174,8 +174,11 @@ TEST_F(Vcan, KernelStampsAreMonotonicAndBracketTheSend) {
     EXPECT_LE(got[i].stamp, after + kMs) << i;
     if (i > 0) {
       EXPECT_GT(got[i].stamp, got[i - 1].stamp) << i;
-      // Sent 5 ms apart (at least: a late wake-up only widens the gap).
-      EXPECT_GE(got[i].stamp - got[i - 1].stamp, 3 * kMs) << i;
+    }
+    // Each stamp belongs to its own send: before the next one started (vcan
+    // hands the frame to the receivers within the sender's write()).
+    if (i + 1 < kFrames) {
+      EXPECT_LT(got[i].stamp, sent_at[i + 1] + kMs) << i;
     }
   }
   std::printf("stamp - send: first %.3f ms, last %.3f ms\n", (got[0].stamp - sent_at[0]) / 1e6,
