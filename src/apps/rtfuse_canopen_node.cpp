@@ -28,7 +28,6 @@ namespace {
 volatile std::sig_atomic_t g_stop = 0;
 void on_signal(int) { g_stop = 1; }
 
-constexpr rtfuse::TimeNs kSecond = 1'000'000'000;
 
 // Frames the nodes send go straight onto the interface; a full TX queue
 // (ENOBUFS on a busy bus) drops the frame as a real node's mailbox would.
