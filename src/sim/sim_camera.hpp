@@ -31,7 +31,8 @@ class SimCamera final : public hal::mock::FrameSource {
   // Fault injection (unplug, refused reopens): drive it from the camera's thread.
   hal::mock::MockVideoStream& mock_stream() { return *stream_; }
   // The sensor stops delivering until `until` (a USB stall, a hung ISP): the
-  // frames due meanwhile are never captured; 0 ends a stall at once.
+  // frames due meanwhile are never captured, and the next one is the first
+  // of the camera's cadence after `until`. A time already past does nothing.
   void stall_until(TimeNs until) noexcept;
   // Capture time of the next frame: what the lockstep drive steps the camera thread up to.
   TimeNs next_frame_time() noexcept override { return next_; }
