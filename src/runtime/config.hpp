@@ -42,6 +42,11 @@ struct StaticTransformConfig {
 struct RealtimeConfig {
   bool lock_memory = false;   // mlockall(MCL_CURRENT | MCL_FUTURE)
   int priority = 0;           // SCHED_FIFO priority of the loop, 0 = leave SCHED_OTHER
+  // SCHED_FIFO priority of the threads the loop depends on (devices, LCM
+  // input, publisher), below the loop's; 0 = SCHED_OTHER. Without it a busy
+  // process starves them even when the loop keeps time: stale sensors, late
+  // outputs (docs/reliability.md, the CPU hog).
+  int io_priority = 0;
   int cpu = -1;               // pin the loop to this CPU, -1 = no affinity
   bool require = false;       // exit instead of warning when the OS refuses
 };

@@ -110,9 +110,15 @@ void read_filter(const Section& s, RuntimeConfig& cfg) {
 }
 
 void read_realtime(const Section& s, RealtimeConfig& rt) {
-  s.reject_unknown({"lock_memory", "priority", "cpu", "require"});
+  s.reject_unknown({"lock_memory", "priority", "io_priority", "cpu", "require"});
   s.read("lock_memory", rt.lock_memory);
   read_int(s, "priority", rt.priority, 0, 99);
+  read_int(s, "io_priority", rt.io_priority, 0, 98);
+  if (rt.io_priority > 0 && rt.io_priority >= rt.priority) {
+    s.value_error("io_priority", "must be below priority (" + std::to_string(rt.priority) + "), got " +
+                                     std::to_string(rt.io_priority) +
+                                     ": the loop must preempt the threads that feed it");
+  }
   read_int(s, "cpu", rt.cpu, -1, 1023);  // CPU_SETSIZE
   s.read("require", rt.require);
 }

@@ -49,6 +49,22 @@ RealtimeOutcome apply_thread_realtime(const RealtimeConfig& rt) {
   return out;
 }
 
+RealtimeOutcome apply_io_priority(const RealtimeConfig& rt, pthread_t thread, const char* what) {
+  RealtimeOutcome out;
+  if (rt.io_priority <= 0) return out;
+  sched_param sp{};
+  sp.sched_priority = rt.io_priority;
+  const int e = pthread_setschedparam(thread, SCHED_FIFO, &sp);
+  if (e != 0) {
+    out.ok = false;
+    out.warnings = std::string("realtime.io_priority: SCHED_FIFO ") + std::to_string(rt.io_priority) + " for " +
+                   what + " refused: " + std::strerror(e) +
+                   " (run as root, grant CAP_SYS_NICE, or raise RLIMIT_RTPRIO: LimitRTPRIO=" +
+                   std::to_string(rt.priority) + ")\n";
+  }
+  return out;
+}
+
 void name_this_thread(const char* name) { pthread_setname_np(pthread_self(), name); }
 
 }  // namespace rtfuse

@@ -1,6 +1,8 @@
 #pragma once
 // Real-time settings the OS may refuse (EPERM without CAP_SYS_NICE /
 // CAP_IPC_LOCK): reported once, fatal only when the config demands them.
+#include <pthread.h>
+
 #include <string>
 
 #include "runtime/config.hpp"
@@ -16,6 +18,9 @@ struct RealtimeOutcome {
 RealtimeOutcome apply_memory_lock(const RealtimeConfig& rt);
 // For the calling thread: SCHED_FIFO priority and CPU affinity.
 RealtimeOutcome apply_thread_realtime(const RealtimeConfig& rt);
+// For another thread of the process: `io_priority` (SCHED_FIFO), if set;
+// `what` names the thread in the warning.
+RealtimeOutcome apply_io_priority(const RealtimeConfig& rt, pthread_t thread, const char* what);
 // Names the calling thread (15 chars max) for top -H and debuggers.
 void name_this_thread(const char* name);
 

@@ -92,6 +92,25 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   for (int i = 0; i < pipeline_->thread_device_count(); ++i) {
     devices_[i] = std::thread(&Runtime::device_thread, this, &pipeline_->thread_device(i));
   }
+  // Set from here, so a refusal is known before start() returns; a thread
+  // runs its first microseconds under SCHED_OTHER, which is still start-up.
+  std::string io_warnings;
+  const auto io = [&](std::thread& t, const char* what) {
+    if (!t.joinable()) return;
+    const RealtimeOutcome r = apply_io_priority(rtc, t.native_handle(), what);
+    if (!r.ok && io_warnings.empty()) io_warnings = r.warnings;  // the same refusal for every thread
+  };
+  io(pub_, "the publisher");
+  io(lcmin_, "the LCM input thread");
+  for (int i = 0; i < pipeline_->thread_device_count(); ++i) io(devices_[i], pipeline_->thread_device(i).name());
+  if (!io_warnings.empty()) {
+    if (rtc.require) {
+      stop();
+      *error = io_warnings + "realtime.require = true: refusing to run without it";
+      return false;
+    }
+    *warnings += io_warnings;
+  }
   return true;
 }
 

@@ -26,7 +26,8 @@ run_case() {  # name lock priority require expected-exit expected-message...
   cp "$src/config/sim.toml" "$cfg"
   [[ -d $work/scenarios ]] || cp -r "$src/config/scenarios" "$work/"  # the config's drive, relative to it
   [[ -d $work/calibration ]] || cp -r "$src/config/calibration" "$work/"  # and its camera's calibration
-  printf '\n[realtime]\nlock_memory = %s\npriority = %s\nrequire = %s\n' "$lock" "$prio" "$require" >> "$cfg"
+  printf '\n[realtime]\nlock_memory = %s\npriority = %s\nio_priority = %s\nrequire = %s\n' \
+    "$lock" "$prio" "${IO_PRIORITY:-0}" "$require" >> "$cfg"
   set +e
   (ulimit -r 0; ulimit -l 64; "${drop[@]}" "$rtfused" --config "$cfg" --duration 1 --quiet --lcm-url memq://) \
     >"$work/$name.out" 2>"$work/$name.err"
@@ -40,13 +41,39 @@ run_case() {  # name lock priority require expected-exit expected-message...
 }
 
 # Optional: warn once per refused setting, then run.
-run_case optional true 50 false 0 "SCHED_FIFO 50 refused: Operation not permitted" "mlockall failed"
+IO_PRIORITY=40 run_case optional true 50 false 0 "SCHED_FIFO 50 refused: Operation not permitted" "mlockall failed" \
+  "io_priority: SCHED_FIFO 40 for the publisher refused: Operation not permitted"
 grep -q "measurements fused" "$work/optional.out" || { echo "FAIL: optional: did not run"; exit 1; }
 # Required: a clear message naming the setting, exit 3, before running.
 run_case required_fifo false 50 true 3 "SCHED_FIFO 50 refused: Operation not permitted" "realtime.require = true"
 run_case required_lock true 0 true 3 "mlockall failed" "realtime.require = true"
 for n in required_fifo required_lock; do
   ! grep -q "measurements fused" "$work/$n.out" || { echo "FAIL: $n ran although refused"; exit 1; }
+done
+
+# Granted (root): the loop at priority, every thread it depends on at
+# io_priority, each under SCHED_FIFO; the simulator's own thread untouched.
+cfg=$work/granted.toml
+cp "$src/config/sim.toml" "$cfg"
+printf '\n[realtime]\npriority = 60\nio_priority = 30\nrequire = true\n' >> "$cfg"
+"$rtfused" --config "$cfg" --duration 120 --quiet --lcm-url memq:// >"$work/out_granted" 2>"$work/err_granted" &
+pid=$!
+for _ in $(seq 120); do
+  sleep 0.5
+  [[ $(cat /proc/$pid/task/*/comm 2>/dev/null | grep -c rtfuse-camera) -ge 1 ]] && break
+done
+policies=""
+for t in /proc/$pid/task/*; do
+  comm=$(cat "$t/comm")
+  # /proc/TID/stat: field 40 is the real-time priority, 41 the policy (1 = SCHED_FIFO).
+  read -r rtprio policy < <(sed -E 's/^.*\) //' "$t/stat" | awk '{print $38, $39}')
+  policies+="$comm:$policy/$rtprio "
+done
+kill -INT $pid
+wait $pid || true
+echo "granted: $policies"
+for want in rtfuse-loop:1/60 rtfuse-pub:1/30 rtfuse-lcmin:1/30 rtfuse-imu:1/30 rtfuse-camera:1/30 rtfuse-sim:0/0; do
+  [[ " $policies " == *" $want "* ]] || { echo "FAIL: granted: expected $want (policy/priority)"; cat "$work/err_granted"; exit 1; }
 done
 
 # Thread names and a clean stop on SIGINT.

@@ -16,13 +16,19 @@
 #                  for SOAK_SECONDS (120) under the probe: nothing allocated in steady
 #                  state, resident memory flat after a 20 s warm-up (sampled every
 #                  5 s, growth <= 64 KiB), overruns counted and reported
+#   cpu_hog        rtfused with every thread on one CPU and two busy processes at nice
+#                  -20 on it for 6 s, twice: every thread under SCHED_OTHER (starved), and
+#                  under SCHED_FIFO ([realtime] priority = 80, io_priority = 70); lcm-logger records the
+#                  diagnostics at 20 Hz, the odometry and the ground truth, and
+#                  check_cpu_hog.py (HOG_CHECK) measures what is reported, when, and
+#                  the estimate meanwhile
 #   disk_full      rtfused --record onto a 1 MiB tmpfs (a private mount namespace):
 #                  the loop runs on to --duration, the write error is named at exit
 #                  (exit 1), and the cut recording replays with --allow-truncated
 #                  (REPLAY) and is refused without it
 #
 # NAME=VALUE settings (passed by tests/system/CMakeLists.txt):
-#   PYTHON CHECK TOOLS_DIR JAVA CLASSPATH_DECODE PROBE PROBE_SELFTEST CONFIG_DIR SOAK_SECONDS
+#   PYTHON CHECK HOG_CHECK TOOLS_DIR JAVA CLASSPATH_DECODE PROBE PROBE_SELFTEST CONFIG_DIR SOAK_SECONDS
 #
 # Exit: 0 pass, 1 fail, 77 skipped (no network namespace and
 # RTFUSE_SKIP_NETNS=1, or no JVM for jvm_decode).
@@ -37,15 +43,15 @@ if [[ $# -lt 3 ]]; then
 fi
 mode=$1 outdir=$2 rtfused=$3
 shift 3
-PYTHON=/usr/bin/python3 CHECK= TOOLS_DIR= JAVA= CLASSPATH_DECODE= PROBE= PROBE_SELFTEST= CONFIG_DIR= SOAK_SECONDS=120 REPLAY=
+PYTHON=/usr/bin/python3 CHECK= HOG_CHECK= TOOLS_DIR= JAVA= CLASSPATH_DECODE= PROBE= PROBE_SELFTEST= CONFIG_DIR= SOAK_SECONDS=120 REPLAY=
 for kv in "$@"; do
   case "$kv" in
-    PYTHON=* | CHECK=* | TOOLS_DIR=* | JAVA=* | CLASSPATH_DECODE=* | PROBE=* | PROBE_SELFTEST=* | CONFIG_DIR=* | SOAK_SECONDS=* | REPLAY=*)
+    PYTHON=* | CHECK=* | HOG_CHECK=* | TOOLS_DIR=* | JAVA=* | CLASSPATH_DECODE=* | PROBE=* | PROBE_SELFTEST=* | CONFIG_DIR=* | SOAK_SECONDS=* | REPLAY=*)
       printf -v "${kv%%=*}" '%s' "${kv#*=}" ;;
     *) echo "$0: unknown setting '$kv'" >&2; exit 2 ;;
   esac
 done
-case "$mode" in udp_multicast | jvm_decode | zero_alloc | live_soak | disk_full) ;; *) echo "$0: unknown mode '$mode'" >&2; exit 2 ;; esac
+case "$mode" in udp_multicast | jvm_decode | zero_alloc | live_soak | cpu_hog | disk_full) ;; *) echo "$0: unknown mode '$mode'" >&2; exit 2 ;; esac
 
 say() { echo "[$mode] $*"; }
 die() { echo "[$mode] FAIL: $*"; exit 1; }
@@ -78,7 +84,7 @@ if [[ "${RTFUSE_SYSTEM_TEST_IN_NETNS:-}" != "1" ]]; then
   rm -rf "$outdir"
   mkdir -p "$outdir"
   RTFUSE_SYSTEM_TEST_IN_NETNS=1 exec "${unshare_cmd[@]}" -- "$BASH" "$0" "$mode" "$outdir" "$rtfused" \
-    PYTHON="$PYTHON" CHECK="$CHECK" TOOLS_DIR="$TOOLS_DIR" JAVA="$JAVA" CLASSPATH_DECODE="$CLASSPATH_DECODE" \
+    PYTHON="$PYTHON" CHECK="$CHECK" HOG_CHECK="$HOG_CHECK" TOOLS_DIR="$TOOLS_DIR" JAVA="$JAVA" CLASSPATH_DECODE="$CLASSPATH_DECODE" \
     PROBE="$PROBE" PROBE_SELFTEST="$PROBE_SELFTEST" CONFIG_DIR="$CONFIG_DIR" SOAK_SECONDS="$SOAK_SECONDS" REPLAY="$REPLAY"
 fi
 
@@ -195,6 +201,57 @@ case "$mode" in
       die "rtfused allocates on the heap in steady state"
     }
     [[ $rc -eq 0 ]] || die "rtfused under the allocation probe exited with status $rc"
+    ;;
+  cpu_hog)
+    [[ -f "$HOG_CHECK" ]] || die "check_cpu_hog.py not found: $HOG_CHECK"
+    [[ -f "$CONFIG_DIR/sim.toml" ]] || die "no config/sim.toml under CONFIG_DIR=$CONFIG_DIR"
+    command -v lcm-logger >/dev/null || die "lcm-logger not found (package liblcm-bin)"
+    command -v taskset >/dev/null || die "taskset not found (package util-linux)"
+    cp -r "$CONFIG_DIR" "$outdir/config"
+    # The CPU everything runs on: the last this process may use (the suite's
+    # other tests are not pinned, so they drift to the rest).
+    cpu=$(taskset -cp $$ | sed -E 's/.*: *//; s/.*[,-]//')
+    for run in starved:0:0 protected:80:70; do
+      IFS=: read -r name priority io <<<"$run"
+      dir="$outdir/$name"
+      mkdir -p "$dir"
+      cfg="$outdir/config/hog_$name.toml"
+      sed -E 's/^diagnostics_rate = [0-9.]+/diagnostics_rate = 20/' "$CONFIG_DIR/sim.toml" >"$cfg"
+      grep -q '^diagnostics_rate = 20' "$cfg" || die "could not set diagnostics_rate in $cfg"
+      printf '\n[realtime]\npriority = %s\nio_priority = %s\nrequire = true\n' "$priority" "$io" >>"$cfg"
+      lcm-logger -q -f --lcm-url="$URL" --channel='rtfuse/diagnostics|rtfuse/odometry|sim/ground_truth' \
+        "$dir/run.lcm" >"$dir/lcm-logger.out" 2>&1 &
+      logger=$!
+      pids+=("$logger")
+      sleep 0.5
+      # Every thread of rtfused on one CPU: a single-core board, or a hog on
+      # the loop's core of a bigger one.
+      timeout -k 5 40 taskset -c "$cpu" "$rtfused" --config "$cfg" --duration 16 --quiet --lcm-url "$URL" \
+        >"$dir/rtfused.stdout" 2>"$dir/rtfused.stderr" &
+      daemon=$!
+      pids+=("$daemon")
+      sleep 5
+      hogs=()
+      for _ in 1 2; do
+        taskset -c "$cpu" nice -n -20 "$BASH" -c 'while :; do :; done' &
+        hogs+=($!)
+        pids+=($!)
+      done
+      echo "start $("$PYTHON" -c 'import time; print(time.time_ns() // 1000, time.monotonic_ns() // 1000)')" >"$dir/hog.txt"
+      sleep 6
+      kill -KILL "${hogs[@]}"
+      wait "${hogs[@]}" 2>/dev/null || true
+      echo "stop $("$PYTHON" -c 'import time; print(time.time_ns() // 1000, time.monotonic_ns() // 1000)')" >>"$dir/hog.txt"
+      rc=0
+      wait "$daemon" || rc=$?
+      sleep 0.3
+      kill -INT "$logger" 2>/dev/null || true
+      wait "$logger" || true
+      show "$dir/rtfused.stderr" "rtfused stderr ($name)"
+      show "$dir/rtfused.stdout" "rtfused stdout ($name)"
+      [[ $rc -eq 0 ]] || die "rtfused ($name, priority $priority) exited with status $rc"
+    done
+    "$PYTHON" "$HOG_CHECK" "$outdir/starved" "$outdir/protected" || die "the CPU hog checks failed"
     ;;
   disk_full)
     [[ -x "$REPLAY" ]] || die "rtfuse-replay not found: $REPLAY"

@@ -82,6 +82,7 @@ yaw_conflict_gate = inf
 [realtime]
 lock_memory = true
 priority = 80
+io_priority = 70
 cpu = 2
 require = true
 
@@ -180,6 +181,7 @@ TEST(ConfigLoader, FullConfigParsesToTheRightValues) {
 
   EXPECT_TRUE(c.realtime.lock_memory);
   EXPECT_EQ(c.realtime.priority, 80);
+  EXPECT_EQ(c.realtime.io_priority, 70);
   EXPECT_EQ(c.realtime.cpu, 2);
   EXPECT_TRUE(c.realtime.require);
   EXPECT_EQ(c.lcm_url, "memq://");
@@ -263,6 +265,7 @@ TEST(ConfigLoader, DefaultsWhenSectionsAreAbsent) {
   EXPECT_DOUBLE_EQ(c.filter.yaw_conflict_gate_sigma, 5.0);
   EXPECT_EQ(c.lcm_url, "udpm://239.255.76.67:7667?ttl=0");
   EXPECT_EQ(c.realtime.priority, 0);
+  EXPECT_EQ(c.realtime.io_priority, 0);
   EXPECT_EQ(c.realtime.cpu, -1);
   EXPECT_EQ(c.publish.diagnostics_channel, "rtfuse/diagnostics");
   EXPECT_DOUBLE_EQ(c.publish.state_rate_hz, 10.0);
@@ -372,6 +375,13 @@ TEST(ConfigLoader, OutOfRangeSaysRangeAndValue) {
             "test.toml:2:13: filter.frequency: must be > 0 and <= 10000 Hz, got -5");
   EXPECT_EQ(single_error(load("[realtime]\npriority = 120\n")),
             "test.toml:2:12: realtime.priority: must be between 0 and 99, got 120");
+  // The loop must preempt the threads that feed it, so they may not match or outrank it.
+  EXPECT_EQ(single_error(load("[realtime]\npriority = 50\nio_priority = 50\n")),
+            "test.toml:3:15: realtime.io_priority: must be below priority (50), got 50: the loop must preempt "
+            "the threads that feed it");
+  EXPECT_EQ(single_error(load("[realtime]\nio_priority = 10\n")),
+            "test.toml:2:15: realtime.io_priority: must be below priority (0), got 10: the loop must preempt "
+            "the threads that feed it");
   EXPECT_EQ(single_error(load(sensor("a", "imu", "c", "queue_size = 0\n"))),
             "test.toml:6:14: sensor[0].queue_size: must be between 1 and 1024, got 0");
   EXPECT_EQ(single_error(load("[sim]\nimu_rate = 0\n")),
