@@ -17,7 +17,7 @@
 #                  state, resident memory flat after a 20 s warm-up (sampled every
 #                  5 s, growth <= 64 KiB), overruns counted and reported
 #   cpu_hog        rtfused with every thread on one CPU and two busy processes at nice
-#                  -20 on it for 6 s, twice: every thread under SCHED_OTHER (starved), and
+#                  -20 on it for 5 s, twice: every thread under SCHED_OTHER (starved), and
 #                  under SCHED_FIFO ([realtime] priority = 80, io_priority = 70); lcm-logger records the
 #                  diagnostics at 20 Hz, the odometry and the ground truth, and
 #                  check_cpu_hog.py (HOG_CHECK) measures what is reported, when, and
@@ -226,11 +226,11 @@ case "$mode" in
       sleep 0.5
       # Every thread of rtfused on one CPU: a single-core board, or a hog on
       # the loop's core of a bigger one.
-      timeout -k 5 40 taskset -c "$cpu" "$rtfused" --config "$cfg" --duration 16 --quiet --lcm-url "$URL" \
+      timeout -k 5 40 taskset -c "$cpu" "$rtfused" --config "$cfg" --duration 12 --quiet --lcm-url "$URL" \
         >"$dir/rtfused.stdout" 2>"$dir/rtfused.stderr" &
       daemon=$!
       pids+=("$daemon")
-      sleep 5
+      sleep 4
       hogs=()
       for _ in 1 2; do
         taskset -c "$cpu" nice -n -20 "$BASH" -c 'while :; do :; done' &
@@ -238,7 +238,7 @@ case "$mode" in
         pids+=($!)
       done
       echo "start $("$PYTHON" -c 'import time; print(time.time_ns() // 1000, time.monotonic_ns() // 1000)')" >"$dir/hog.txt"
-      sleep 6
+      sleep 5
       kill -KILL "${hogs[@]}"
       wait "${hogs[@]}" 2>/dev/null || true
       echo "stop $("$PYTHON" -c 'import time; print(time.time_ns() // 1000, time.monotonic_ns() // 1000)')" >>"$dir/hog.txt"
