@@ -201,6 +201,7 @@ int main(int argc, char** argv) {
   long err_samples = 0;
   double last_error = NAN;
   rtfuse::Snapshot s;
+  bool recording_failure_said = false;
 
   while (!g_stop.load() && rtfuse::monotonic_now_ns() < end) {
     rtfuse::sleep_until(std::min(end, next_sample));
@@ -212,6 +213,17 @@ int main(int argc, char** argv) {
     if (now < next_sample) continue;
     next_sample = now + 100'000'000;
     s = runtime->latest();
+    // Said when it happens (the journal of a service), not only at exit;
+    // allocates once, on the failure.
+    if (!recording_failure_said && runtime->recording() != nullptr && runtime->recording()->recorder().failed()) {
+      std::string why;
+      runtime->recording()->recorder().failed(&why);
+      std::fprintf(stderr,
+                   "rtfused: recording %s failed at %.1f s: %s; the loop runs on, the recording is cut there "
+                   "(rtfuse-replay --allow-truncated)\n",
+                   record_path.c_str(), rtfuse::ns_to_sec(now - start), why.c_str());
+      recording_failure_said = true;
+    }
     if ((sim || robot) && s.initialized) {
       double tx = 0.0, ty = 0.0;
       if (sim) {

@@ -199,7 +199,10 @@ bool Recorder::stop(std::string* error) {
     std::string why;
     if (!writer_.close(&why)) {
       write_errors_.fetch_add(1, std::memory_order_relaxed);
-      if (first_error_.empty()) first_error_ = why;
+      if (first_error_.empty()) {
+        first_error_ = why;
+        failed_.store(true, std::memory_order_release);
+      }
     }
   }
   if (!first_error_.empty()) {
@@ -233,13 +236,22 @@ void Recorder::write(std::int64_t utime, std::string_view channel, const std::ui
   }
   if (!ok) {
     write_errors_.fetch_add(1, std::memory_order_relaxed);
-    if (first_error_.empty()) first_error_ = why;
+    if (first_error_.empty()) {
+      first_error_ = why;
+      failed_.store(true, std::memory_order_release);  // first_error_ never changes after this
+    }
     return;
   }
   events_written_.fetch_add(1, std::memory_order_relaxed);
   last_utime_ = std::max(last_utime_, utime);
   bytes_written_.fetch_add(static_cast<std::int64_t>(transport::kEventHeaderSize + channel.size() + size),
                            std::memory_order_relaxed);
+}
+
+bool Recorder::failed(std::string* why) const {
+  if (!failed_.load(std::memory_order_acquire)) return false;
+  if (why != nullptr) *why = first_error_;
+  return true;
 }
 
 std::size_t Recorder::drain_once() noexcept {

@@ -143,6 +143,10 @@ class Recorder {
 
   // Counters so far; allocates (call from a non-RT thread).
   RecorderStats stats() const;
+  // Whether a record failed to reach the file (disk full, I/O error), and
+  // the first reason, while the writer runs: rtfused says so at once
+  // instead of at exit. Any thread but the writer; *why allocates.
+  bool failed(std::string* why = nullptr) const;
 
   // True while some ring is more than half full. A lockstep producer (the
   // simulator, which runs as fast as the CPU allows) waits on it so the
@@ -180,7 +184,8 @@ class Recorder {
   std::thread thread_;
   std::atomic<bool> stop_requested_{false};
   bool stopped_ = false;
-  std::string first_error_;  // writer thread; read after join
+  std::string first_error_;  // writer thread; set once, then published by failed_
+  std::atomic<bool> failed_{false};
   std::int64_t last_utime_ = 0;  // writer thread: the newest event's stamp, for the end record
 
   std::atomic<std::int64_t> events_written_{0};

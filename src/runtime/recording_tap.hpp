@@ -40,6 +40,7 @@ class RecordingTap {
   ~RecordingTap();
   HalBuses buses() const { return buses_; }
   runtime::Recorder& recorder() { return *recorder_; }
+  const runtime::Recorder& recorder() const { return *recorder_; }
   // Events the decorators could not queue (ring full), all devices.
   std::int64_t overflows() const;
 

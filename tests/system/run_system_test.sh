@@ -270,6 +270,12 @@ case "$mode" in
     ((rc == 1)) || die "rtfused recording onto a full disk exited $rc, expected 1"
     grep -q "recording $disk/rec.lcm: .*No space left on device" "$outdir/rtfused.stderr" ||
       die "rtfused did not name the full disk (ENOSPC) and the file"
+    # Said while it ran (the service's journal), not only at exit.
+    at=$(sed -nE "s|^rtfused: recording $disk/rec.lcm failed at ([0-9.]+) s: .*No space left on device.*|\1|p" \
+      "$outdir/rtfused.stderr")
+    [[ -n $at ]] || die "rtfused did not report the failed recording while it ran"
+    awk -v t="$at" 'BEGIN { exit !(t < 3.5) }' || die "the failed recording was reported at $at s, not during the 4 s run"
+    say "the full disk was reported $at s into the run"
     # The loop was not held up by the writer: ~4 s of 200 Hz ticks.
     ticks=$(sed -nE 's/^rtfused: ran .* ([0-9]+) ticks.*/\1/p' "$outdir/rtfused.stdout")
     [[ -n $ticks ]] && ((ticks >= 700)) || die "the loop ran ${ticks:-no} ticks in 4 s at 200 Hz (>= 700 expected)"
