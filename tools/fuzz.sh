@@ -33,7 +33,7 @@ while (($#)); do
     *) harnesses+=("$1"); shift ;;
   esac
 done
-all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti daemon_input)
+all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss daemon_input)
 ((${#harnesses[@]})) || harnesses=("${all[@]}")
 
 "$root/tools/setup-deps.sh"
@@ -66,6 +66,37 @@ fi
 for h in "${all[@]}"; do
   [[ -d "$root/tests/fuzz/regressions/$h" ]] && cp "$root/tests/fuzz/regressions/$h"/* "$seeds/$h/"
 done
+# A receiver's output: NMEA epochs (GGA, RMC, GSA, GST) and UBX NAV-PVT
+# frames, alone and interleaved; the first byte is the harness's selector.
+/usr/bin/python3 - "$seeds/gnss" <<'PY'
+import functools, struct, sys
+def nmea(body):
+    return ("$%s*%02X\r\n" % (body, functools.reduce(lambda a, c: a ^ ord(c), body, 0))).encode()
+def ubx(cls, mid, payload):
+    body = bytes([cls, mid]) + struct.pack("<H", len(payload)) + payload
+    a = b = 0
+    for x in body:
+        a = (a + x) & 0xFF
+        b = (b + a) & 0xFF
+    return b"\xb5\x62" + body + bytes([a, b])
+def pvt(fix_type, flags):
+    p = bytearray(92)
+    struct.pack_into("<IHBBBBBBIiBBBBiiiiIIiiiiiIIH", p, 0, 45319200, 2026, 11, 26, 12, 35, 19, 7, 50, 200000000,
+                     fix_type, flags, 0, 12, 115166667, 481173000, 592300, 545400, 1500, 2500, 1000, -500, 200,
+                     1118, 9000000, 300, 1000000, 130)
+    return ubx(1, 7, bytes(p))
+epoch = b"".join(nmea(s) for s in (
+    "GPRMC,123519.00,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W,A",
+    "GPGGA,123519.00,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,",
+    "GPGSA,A,3,04,05,,09,12,,,24,,,,,2.5,1.3,2.1",
+    "GPGST,123519.00,0.006,0.023,0.020,273.6,0.023,0.020,0.031"))
+nofix = nmea("GPGGA,123520.00,,,,,0,00,99.99,,,,,,") + nmea("GPRMC,123520.00,V,,,,,,,230394,,,N")
+frames = b"".join(pvt(t, f) for t, f in ((3, 1), (2, 3), (4, 0x81), (1, 0), (3, 0)))
+for sel in range(4):
+    open(f"{sys.argv[1]}/nmea{sel}", "wb").write(bytes([sel]) + epoch + nofix)
+open(f"{sys.argv[1]}/ubx", "wb").write(b"\x00" + frames)
+open(f"{sys.argv[1]}/mixed", "wb").write(b"\x03" + pvt(3, 1) + epoch + pvt(3, 1) + nofix)
+PY
 # The daemon's input path takes the decoders' messages, with their selector.
 cp "$seeds/sample_decoder"/* "$seeds/daemon_input/"
 
