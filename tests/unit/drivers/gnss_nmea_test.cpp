@@ -13,6 +13,7 @@
 #include "drivers/gnss/nmea_framer.hpp"
 #include "drivers/gnss/nmea_sentences.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/gnss_bytes.hpp"
 
 namespace rtfuse::drivers {
 namespace {
@@ -22,13 +23,7 @@ const char* kRmc = "$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,00
 const char* kGst = "$GPGST,172814.0,0.006,0.023,0.020,273.6,0.023,0.020,0.031*6A\r\n";
 
 // A sentence body with its checksum, for the cases no textbook prints.
-std::string sentence(const std::string& body) {
-  unsigned sum = 0;
-  for (char c : body) sum ^= static_cast<unsigned char>(c);
-  char tail[8];
-  std::snprintf(tail, sizeof tail, "*%02X\r\n", sum);
-  return "$" + body + tail;
-}
+std::string sentence(const std::string& body) { return test::nmea_sentence(body); }
 
 // Every sentence the framer completes from `bytes`, each byte stamped with its index.
 std::vector<NmeaFramer::Sentence> frame(NmeaFramer& f, const std::string& bytes, std::vector<std::string>* texts) {

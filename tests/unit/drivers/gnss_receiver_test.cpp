@@ -12,19 +12,14 @@
 #include "hal/mock/mock_serial_port.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/gnss_bytes.hpp"
 
 namespace rtfuse::drivers {
 namespace {
 
 constexpr TimeNs kMs = 1'000'000;
 
-std::string sentence(const std::string& body) {
-  unsigned sum = 0;
-  for (char c : body) sum ^= static_cast<unsigned char>(c);
-  char tail[8];
-  std::snprintf(tail, sizeof tail, "*%02X\r\n", sum);
-  return "$" + body + tail;
-}
+std::string sentence(const std::string& body) { return test::nmea_sentence(body); }
 
 std::vector<std::uint8_t> nav_pvt(int hour, int min, int sec, int fix_type, int flags) {
   std::vector<std::uint8_t> p(92, 0);
@@ -39,20 +34,7 @@ std::vector<std::uint8_t> nav_pvt(int hour, int min, int sec, int fix_type, int 
     p[24 + i] = static_cast<std::uint8_t>(lon >> (8 * i));
     p[28 + i] = static_cast<std::uint8_t>(lat >> (8 * i));
   }
-  // Built in one piece: GCC 12's -Warray-bounds misreads an insert after a
-  // 6-byte initializer list.
-  std::vector<std::uint8_t> f(6 + p.size());
-  const std::uint8_t head[6] = {0xB5, 0x62, 0x01, 0x07, 92, 0};
-  std::copy(head, head + 6, f.begin());
-  std::copy(p.begin(), p.end(), f.begin() + 6);
-  std::uint8_t a = 0, b = 0;
-  for (std::size_t i = 2; i < f.size(); ++i) {
-    a = static_cast<std::uint8_t>(a + f[i]);
-    b = static_cast<std::uint8_t>(b + a);
-  }
-  f.push_back(a);
-  f.push_back(b);
-  return f;
+  return test::ubx_frame(0x01, 0x07, p);
 }
 
 struct Rig {

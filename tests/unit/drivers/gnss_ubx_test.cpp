@@ -11,6 +11,7 @@
 #include "drivers/gnss/ubx_framer.hpp"
 #include "drivers/gnss/ubx_nav_pvt.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/gnss_bytes.hpp"
 
 namespace rtfuse::drivers {
 namespace {
@@ -21,19 +22,7 @@ void put(Bytes& b, std::size_t at, std::int64_t v, int n) {
   for (int i = 0; i < n; ++i) b[at + static_cast<std::size_t>(i)] = static_cast<std::uint8_t>(v >> (8 * i));
 }
 
-Bytes frame(std::uint8_t cls, std::uint8_t id, const Bytes& payload) {
-  Bytes f = {0xB5, 0x62, cls, id, static_cast<std::uint8_t>(payload.size()),
-             static_cast<std::uint8_t>(payload.size() >> 8)};
-  f.insert(f.end(), payload.begin(), payload.end());
-  std::uint8_t a = 0, b = 0;
-  for (std::size_t i = 2; i < f.size(); ++i) {
-    a = static_cast<std::uint8_t>(a + f[i]);
-    b = static_cast<std::uint8_t>(b + a);
-  }
-  f.push_back(a);
-  f.push_back(b);
-  return f;
-}
+Bytes frame(std::uint8_t cls, std::uint8_t id, const Bytes& payload) { return test::ubx_frame(cls, id, payload); }
 
 struct Pvt {
   int fix_type = 3;
