@@ -58,21 +58,26 @@ cp "$src/config/sim.toml" "$cfg"
 printf '\n[realtime]\npriority = 60\nio_priority = 30\nrequire = true\n' >> "$cfg"
 "$rtfused" --config "$cfg" --duration 120 --quiet --lcm-url memq:// >"$work/out_granted" 2>"$work/err_granted" &
 pid=$!
+wanted=(rtfuse-loop:1/60 rtfuse-pub:1/30 rtfuse-lcmin:1/30 rtfuse-imu:1/30 rtfuse-camera:1/30 rtfuse-sim:0/0)
+# Start-up takes seconds under emulation, and a thread exists a moment
+# before start() sets its policy: poll until every one is as wanted.
 for _ in $(seq 120); do
   sleep 0.5
-  [[ $(cat /proc/$pid/task/*/comm 2>/dev/null | grep -c rtfuse-camera) -ge 1 ]] && break
-done
-policies=""
-for t in /proc/$pid/task/*; do
-  comm=$(cat "$t/comm")
-  # /proc/TID/stat: field 40 is the real-time priority, 41 the policy (1 = SCHED_FIFO).
-  read -r rtprio policy < <(sed -E 's/^.*\) //' "$t/stat" | awk '{print $38, $39}')
-  policies+="$comm:$policy/$rtprio "
+  policies=""
+  for t in /proc/$pid/task/*; do
+    comm=$(cat "$t/comm" 2>/dev/null) || continue
+    # /proc/TID/stat after "(comm) ": field 40 is the real-time priority, 41 the policy (1 = SCHED_FIFO).
+    read -r rtprio policy < <(sed -E 's/^.*\) //' "$t/stat" 2>/dev/null | awk '{print $38, $39}') || continue
+    policies+="$comm:$policy/$rtprio "
+  done
+  missing=0
+  for want in "${wanted[@]}"; do [[ " $policies " == *" $want "* ]] || missing=1; done
+  ((missing == 0)) && break
 done
 kill -INT $pid
 wait $pid || true
 echo "granted: $policies"
-for want in rtfuse-loop:1/60 rtfuse-pub:1/30 rtfuse-lcmin:1/30 rtfuse-imu:1/30 rtfuse-camera:1/30 rtfuse-sim:0/0; do
+for want in "${wanted[@]}"; do
   [[ " $policies " == *" $want "* ]] || { echo "FAIL: granted: expected $want (policy/priority)"; cat "$work/err_granted"; exit 1; }
 done
 
