@@ -5,6 +5,7 @@
 #include <gtest/gtest.h>
 
 #include <cstdint>
+#include <cstring>
 #include <vector>
 
 #include "drivers/gnss/nmea_framer.hpp"
@@ -99,7 +100,7 @@ TEST(UbxFramer, ABadChecksumOrAnImpossibleLengthLosesOnlyItsOwnFrame) {
   stream.insert(stream.end(), huge.begin(), huge.end());
   stream.insert(stream.end(), good.begin(), good.end());
   const char* nmea = "$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n";
-  stream.insert(stream.end(), nmea, nmea + 69);  // an NMEA sentence on the same port
+  stream.insert(stream.end(), nmea, nmea + std::strlen(nmea));  // an NMEA sentence on the same port
   stream.insert(stream.end(), good.begin(), good.end());
   std::vector<Bytes> payloads;
   const auto frames = feed(f, stream, &payloads);
@@ -107,7 +108,7 @@ TEST(UbxFramer, ABadChecksumOrAnImpossibleLengthLosesOnlyItsOwnFrame) {
   EXPECT_EQ(payloads[0], pvt_payload(Pvt{}));
   EXPECT_EQ(f.stats().bad_checksum, 1);
   EXPECT_EQ(f.stats().oversize, 1);
-  EXPECT_EQ(f.stats().skipped_bytes, 69);
+  EXPECT_EQ(f.stats().skipped_bytes, static_cast<std::int64_t>(std::strlen(nmea)));
 
   // And the NMEA framer on the same stream finds its sentence among the binary.
   NmeaFramer n;
