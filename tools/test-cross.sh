@@ -48,4 +48,8 @@ if "$root/tools/check-target-abi.sh" "${apps[@]}" --glibc 2.27; then
 fi
 
 cd "$dir"
-ctest --output-on-failure -j2 -L 'unit|integration|system|package' "$@"
+# qemu-user's termios translation has no B921600: the emulator hands the
+# kernel another rate and the serial backend rightly refuses the port. Not
+# the target's behaviour (an arm64 kernel has the rate); the native stage runs it.
+ctest --output-on-failure -j2 -L 'unit|integration|system|package' \
+  -E '^HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack$' "$@"
