@@ -18,7 +18,7 @@ const char* to_string(GnssHealth h) noexcept {
 GnssReceiver::GnssReceiver(hal::SerialPort& port, hal::Clock& clock, const GnssReceiverConfig& config) noexcept
     : port_(port), clock_(clock), config_(config), assembler_(config.nmea), started_(clock.now()) {}
 
-bool GnssReceiver::take(const GnssFix& fix, GnssFix* out) noexcept {
+void GnssReceiver::take(const GnssFix& fix, GnssFix* out) noexcept {
   ++stats_.epochs;
   if (fix.status == GnssStatus::kNoFix) ++stats_.no_fix_epochs;
   if (fix.dead_reckoning) ++stats_.dead_reckoning;
@@ -32,7 +32,6 @@ bool GnssReceiver::take(const GnssFix& fix, GnssFix* out) noexcept {
   }
   health_ = fix.status == GnssStatus::kNoFix ? GnssHealth::kNoFix : GnssHealth::kFix;
   *out = fix;
-  return true;
 }
 
 int GnssReceiver::poll(TimeNs timeout_ns, GnssFix* out, int max) noexcept {
@@ -50,7 +49,7 @@ int GnssReceiver::poll(TimeNs timeout_ns, GnssFix* out, int max) noexcept {
         NmeaFramer::Sentence s;
         if (nmea_.push(buf_[i], stamp, &s) && assembler_.add(s, &fix)) {
           if (fixes < max) {
-            fixes += take(fix, out + fixes) ? 1 : 0;
+            take(fix, out + fixes++);
           } else {
             ++stats_.lost_epochs;
           }
@@ -66,7 +65,7 @@ int GnssReceiver::poll(TimeNs timeout_ns, GnssFix* out, int max) noexcept {
           continue;
         }
         if (fixes < max) {
-          fixes += take(fix, out + fixes) ? 1 : 0;
+          take(fix, out + fixes++);
         } else {
           ++stats_.lost_epochs;
         }

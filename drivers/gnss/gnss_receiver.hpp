@@ -72,7 +72,8 @@ class GnssReceiver {
   TimeNs last_byte() const noexcept { return last_byte_; }
 
  private:
-  bool take(const GnssFix& fix, GnssFix* out) noexcept;
+  // Counts the epoch, follows its health, and copies it out.
+  void take(const GnssFix& fix, GnssFix* out) noexcept;
 
   hal::SerialPort& port_;
   hal::Clock& clock_;
