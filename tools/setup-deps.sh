@@ -38,6 +38,10 @@ packages=(
   # the stereo rectification's reference in the test build (tests/reference);
   # never linked into the runtime
   libopencv-dev
+  # the geodesy's reference in the test build (tests/reference): the
+  # GeographicLib robot_localization projects with; never linked into the
+  # runtime (src/estimation/geodesy.hpp says why)
+  libgeographiclib-dev
 )
 
 missing=()

@@ -8,6 +8,7 @@
 #include <Eigen/Geometry>
 
 #include "core/time.hpp"
+#include "estimation/geodesy.hpp"
 #include "estimation/state.hpp"
 
 namespace rtfuse::est {
@@ -36,6 +37,14 @@ struct ImuSample {
   Matrix3 angular_velocity_covariance = Matrix3::Zero();
   Eigen::Vector3d linear_acceleration = Eigen::Vector3d::Zero();
   Matrix3 linear_acceleration_covariance = Matrix3::Zero();
+};
+
+// sensor_msgs/NavSatFix, keeping its status and covariance-type values.
+struct NavSatFixSample {
+  std::int8_t status = -1;           // NavSatStatus: -1 no fix, 0 fix, 1 SBAS, 2 GBAS
+  std::uint8_t covariance_type = 0;  // 0 unknown, 1 approximated, 2 diagonal known, 3 known
+  GeodeticPosition position;         // of the antenna
+  Matrix3 covariance = Matrix3::Zero();  // east north up, m²
 };
 
 // Frame ids are resolved to indices of the runtime's FrameTree by the decoder
