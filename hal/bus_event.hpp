@@ -30,6 +30,8 @@ enum class BusEventKind : std::uint8_t {
   kGpioSet,
   kClockNow,
   kClockSleepUntil,
+  kSerialRead,
+  kSerialWrite,
 };
 
 // The call's name as divergence reports and logs spell it.
@@ -44,6 +46,8 @@ inline const char* to_string(BusEventKind k) noexcept {
     case BusEventKind::kGpioSet: return "gpio_set";
     case BusEventKind::kClockNow: return "clock_now";
     case BusEventKind::kClockSleepUntil: return "clock_sleep_until";
+    case BusEventKind::kSerialRead: return "serial_read";
+    case BusEventKind::kSerialWrite: return "serial_write";
   }
   return "unknown";
 }
@@ -52,16 +56,21 @@ inline const char* to_string(BusEventKind k) noexcept {
 // `max` at this, in recording and in replay alike, so one call is always one
 // event (the CanBus contract already lets receive return fewer than asked).
 constexpr int kBusEventMaxFrames = 16;
-// The I2cBus contract's largest read.
+// The I2cBus contract's largest read, and the most bytes one serial_read or
+// serial_write event holds: the recording decorator caps a serial read's
+// `max` at this and splits a longer write, in recording and replay alike.
 constexpr int kBusEventMaxBytes = 64;
 
 struct BusEvent {
   TimeNs time_ns = 0;     // clock time of the call; 0 when the decorator has no clock
-  TimeNs timeout_ns = 0;  // can_receive / gpio_wait_edge: the timeout argument
+  TimeNs timeout_ns = 0;  // can_receive / gpio_wait_edge / serial_read: the timeout argument
   TimeNs clock_ns = 0;    // clock_now: the value returned; clock_sleep_until: the deadline
-  TimeNs edge_stamp = 0;  // gpio_wait_edge with kOk: the edge's kernel stamp
+  // gpio_wait_edge with kOk: the edge's kernel stamp; serial_read with
+  // bytes: when the port saw them.
+  TimeNs edge_stamp = 0;
   std::int64_t retries = 0;  // i2c: the bus's retries() counter after the call
-  // i2c_read: bytes asked for; i2c_write: 1; can_receive: `max` after the cap.
+  // i2c_read: bytes asked for; i2c_write: 1; can_receive and serial_read:
+  // `max` after the cap; serial_write: bytes written.
   std::int32_t length = 0;
   // Events of the same decorator that found the ring full just before this
   // one: the recording has a hole here.
@@ -71,7 +80,7 @@ struct BusEvent {
   std::uint8_t device = 0;  // index of the recorded bus instance (the recording's device table)
   HalStatus status = HalStatus::kOk;
   CanBusState bus_state = CanBusState::kUnknown;  // can: state() after the call
-  std::uint8_t count = 0;    // can_send: 1; can_receive: frames returned
+  std::uint8_t count = 0;    // can_send: 1; can_receive: frames returned; serial_read: bytes returned
   std::uint8_t address = 0;  // i2c: 7-bit device address
   std::uint8_t reg = 0;      // i2c: register
   std::uint8_t value = 0;    // i2c_write: the byte written
@@ -79,7 +88,9 @@ struct BusEvent {
   std::uint8_t reserved[7] = {};  // explicit so the layout has no padding bytes
 
   CanFrame frames[kBusEventMaxFrames] = {};  // can_send: frames[0]; can_receive: count frames
-  std::uint8_t data[kBusEventMaxBytes] = {};  // i2c_read with kOk: `length` bytes read
+  // i2c_read with kOk: `length` bytes read; serial_read: `count` bytes
+  // read; serial_write: the `length` bytes written.
+  std::uint8_t data[kBusEventMaxBytes] = {};
 };
 
 static_assert(std::is_trivially_copyable_v<BusEvent>, "BusEvent travels through SPSC rings by copy");

@@ -15,10 +15,19 @@ namespace {
 // Everything before the frames: the fixed part every event keeps.
 constexpr std::size_t kHeadBytes = offsetof(BusEvent, frames);
 
-int stored_frames(const BusEvent& ev) { return std::min<int>(ev.count, kBusEventMaxFrames); }
-
 int stored_bytes(const BusEvent& ev) {
-  return ev.kind == BusEventKind::kI2cRead ? std::clamp(ev.length, 0, kBusEventMaxBytes) : 0;
+  switch (ev.kind) {
+    case BusEventKind::kI2cRead:
+    case BusEventKind::kSerialWrite: return std::clamp(ev.length, 0, kBusEventMaxBytes);
+    case BusEventKind::kSerialRead: return std::min<int>(ev.count, kBusEventMaxBytes);
+    default: return 0;
+  }
+}
+
+int stored_frames(const BusEvent& ev) {
+  return ev.kind == BusEventKind::kCanSend || ev.kind == BusEventKind::kCanReceive
+             ? std::min<int>(ev.count, kBusEventMaxFrames)
+             : 0;
 }
 
 bool same_frame(const CanFrame& a, const CanFrame& b) {
@@ -42,6 +51,10 @@ bool same_call(const BusEvent& rec, const BusEvent& call) {
     case BusEventKind::kGpioSet: return rec.level == call.level;
     case BusEventKind::kClockNow: return true;
     case BusEventKind::kClockSleepUntil: return rec.clock_ns == call.clock_ns;
+    case BusEventKind::kSerialRead: return rec.length == call.length && rec.timeout_ns == call.timeout_ns;
+    case BusEventKind::kSerialWrite:
+      return rec.length == call.length &&
+             std::memcmp(rec.data, call.data, static_cast<std::size_t>(stored_bytes(rec))) == 0;
     case BusEventKind::kNone: return true;
   }
   return false;
@@ -162,6 +175,16 @@ int ReplayStream::describe(char* buf, std::size_t size, const BusEvent& ev, bool
     case BusEventKind::kGpioWaitEdge: t.add(" timeout %lld ns", static_cast<long long>(ev.timeout_ns)); break;
     case BusEventKind::kGpioSet: t.add(ev.level != 0 ? " high" : " low"); break;
     case BusEventKind::kClockSleepUntil: t.add(" deadline %lld ns", static_cast<long long>(ev.clock_ns)); break;
+    case BusEventKind::kSerialRead:
+      t.add(" max %d timeout %lld ns", ev.length, static_cast<long long>(ev.timeout_ns));
+      break;
+    case BusEventKind::kSerialWrite: {
+      t.add(" %d bytes [", ev.length);
+      const int n = std::min(stored_bytes(ev), 16);
+      for (int i = 0; i < n; ++i) t.add(i == 0 ? "%02X" : " %02X", ev.data[i]);
+      t.add(n < ev.length ? " ...]" : "]");
+      break;
+    }
     case BusEventKind::kClockNow:
     case BusEventKind::kNone: break;
   }

@@ -191,6 +191,9 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
         }
         break;
       case transport::DeviceKind::kGpioOutput: break;
+      // No device of this build reads a serial port yet: its calls stay
+      // unreplayed, and the loop's recorded intake says whether that matters.
+      case transport::DeviceKind::kSerial: break;
       case transport::DeviceKind::kVideo:
         if (dev.stream == camera && !video && static_cast<std::size_t>(dev.stream) < rec.videos.size() &&
             rec.videos[static_cast<std::size_t>(dev.stream)]) {

@@ -10,6 +10,7 @@
 #include "rtfuse/hal_clock_t.hpp"
 #include "rtfuse/hal_gpio_t.hpp"
 #include "rtfuse/hal_i2c_t.hpp"
+#include "rtfuse/hal_serial_t.hpp"
 #include "rtfuse/hal_video_t.hpp"
 #include "rtfuse/loop_tick_t.hpp"
 #include "rtfuse/recording_end_t.hpp"
@@ -93,6 +94,7 @@ const char* to_string(DeviceKind k) noexcept {
     case DeviceKind::kGpioOutput: return "gpio-output";
     case DeviceKind::kClock: return "clock";
     case DeviceKind::kVideo: return "video";
+    case DeviceKind::kSerial: return "serial";
   }
   return "unknown";
 }
@@ -105,6 +107,7 @@ bool records(DeviceKind device, BusEventKind call) noexcept {
     case DeviceKind::kGpioOutput: return call == BusEventKind::kGpioSet;
     case DeviceKind::kClock: return call == BusEventKind::kClockNow || call == BusEventKind::kClockSleepUntil;
     case DeviceKind::kVideo: return false;  // hal_video_t, through HalRecordCodec::encode_video
+    case DeviceKind::kSerial: return call == BusEventKind::kSerialRead || call == BusEventKind::kSerialWrite;
   }
   return false;
 }
@@ -179,7 +182,7 @@ bool validate(const RecordingInfo& info, std::string* error) {
                            " characters without '/' or spaces (it becomes the channel rtfuse/hal/<name>)");
       return false;
     }
-    if (static_cast<int>(d.kind) > static_cast<int>(DeviceKind::kVideo)) {
+    if (static_cast<int>(d.kind) > static_cast<int>(kLastDeviceKind)) {
       set_error(error, where + ": unknown device kind " + std::to_string(static_cast<int>(d.kind)));
       return false;
     }
@@ -285,7 +288,7 @@ bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::
   info.streams = m.streams;
   for (int i = 0; i < m.num_devices; ++i) {
     const auto idx = static_cast<std::size_t>(i);
-    if (m.device_kinds[idx] < 0 || m.device_kinds[idx] > static_cast<std::int8_t>(DeviceKind::kVideo)) {
+    if (m.device_kinds[idx] < 0 || m.device_kinds[idx] > static_cast<std::int8_t>(kLastDeviceKind)) {
       set_error(error, "recording_info_t: device " + std::to_string(i) + " has unknown kind " +
                            std::to_string(m.device_kinds[idx]));
       return false;
@@ -364,6 +367,7 @@ struct HalRecordCodec::Messages {
   rtfuse::hal_gpio_t gpio;
   rtfuse::hal_clock_t clock;
   rtfuse::hal_video_t video;
+  rtfuse::hal_serial_t serial;
   rtfuse::loop_tick_t tick;
 };
 
@@ -373,9 +377,11 @@ HalRecordCodec::HalRecordCodec(std::vector<RecordedDevice> devices)
   // Capacity up front, so encoding stops allocating once every name was used.
   msgs_->can.frames.reserve(hal::kBusEventMaxFrames);
   msgs_->i2c.data.reserve(hal::kBusEventMaxBytes);
+  msgs_->serial.data.reserve(hal::kBusEventMaxBytes);
   msgs_->tick.consumed.reserve(kMaxTickSensors);
   for (std::string* s :
-       {&msgs_->can.device, &msgs_->i2c.device, &msgs_->gpio.device, &msgs_->clock.device, &msgs_->video.device}) {
+       {&msgs_->can.device, &msgs_->i2c.device, &msgs_->gpio.device, &msgs_->clock.device, &msgs_->video.device,
+        &msgs_->serial.device}) {
     s->reserve(kMaxDeviceNameLength);
   }
 }
@@ -472,6 +478,22 @@ int HalRecordCodec::encode(const BusEvent& ev, std::uint8_t* buf, int capacity) 
       m.status = status;
       m.value_ns = ev.clock_ns;
       m.lost_before = lost;
+      return encode_into(m, buf, capacity);
+    }
+    case DeviceKind::kSerial: {
+      rtfuse::hal_serial_t& m = msgs_->serial;
+      const bool read = ev.kind == BusEventKind::kSerialRead;
+      m.utime = utime;
+      m.time_ns = ev.time_ns;
+      m.device = dev.name;
+      m.call = read ? rtfuse::hal_serial_t::READ : rtfuse::hal_serial_t::WRITE;
+      m.status = status;
+      m.length = ev.length;
+      m.timeout_ns = ev.timeout_ns;
+      m.stamp_ns = ev.edge_stamp;
+      m.lost_before = lost;
+      m.num_data = std::clamp<int>(read ? ev.count : ev.length, 0, hal::kBusEventMaxBytes);
+      m.data.assign(ev.data, ev.data + m.num_data);
       return encode_into(m, buf, capacity);
     }
     case DeviceKind::kVideo: return -1;  // records() said no already
@@ -602,6 +624,37 @@ bool HalRecordCodec::decode(std::string_view channel, const void* data, int size
       }
       ev.kind = m.call == rtfuse::hal_clock_t::NOW ? BusEventKind::kClockNow : BusEventKind::kClockSleepUntil;
       ev.clock_ns = m.value_ns;
+      ev.time_ns = m.time_ns;
+      ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
+      break;
+    }
+    case DeviceKind::kSerial: {
+      constexpr const char* kType = "hal_serial_t";
+      // call, status, length, timeout_ns, stamp_ns, lost_before: 26 bytes to num_data.
+      if (!count_within(b, size, after_name < 0 ? -1 : after_name + 26, hal::kBusEventMaxBytes)) {
+        set_error(error, "malformed hal_serial_t: too short, or more than 64 data bytes");
+        return false;
+      }
+      rtfuse::hal_serial_t& m = msgs_->serial;
+      if (!decode_message(m, data, size, kType, error) || !check_common(m.device, m.status, kType)) return false;
+      if (m.call != rtfuse::hal_serial_t::READ && m.call != rtfuse::hal_serial_t::WRITE) {
+        return bad_field(error, kType, "call", m.call);
+      }
+      const bool read = m.call == rtfuse::hal_serial_t::READ;
+      if (m.length < 0 || m.length > hal::kBusEventMaxBytes) return bad_field(error, kType, "length", m.length);
+      if (read ? m.num_data > m.length : m.num_data != m.length) {
+        return bad_field(error, kType, "data byte count", m.num_data);
+      }
+      // Canonical events only: a stamp belongs to a read that got bytes, a
+      // timeout to a read.
+      if (m.stamp_ns != 0 && !(read && m.num_data > 0)) return bad_field(error, kType, "stamp_ns", m.stamp_ns);
+      if (m.timeout_ns != 0 && !read) return bad_field(error, kType, "timeout_ns of a write", m.timeout_ns);
+      ev.kind = read ? BusEventKind::kSerialRead : BusEventKind::kSerialWrite;
+      ev.length = m.length;
+      ev.timeout_ns = m.timeout_ns;
+      ev.edge_stamp = m.stamp_ns;
+      ev.count = read ? static_cast<std::uint8_t>(m.num_data) : 0;
+      std::copy(m.data.begin(), m.data.begin() + m.num_data, ev.data);
       ev.time_ns = m.time_ns;
       ev.lost_before = static_cast<std::uint32_t>(m.lost_before);
       break;

@@ -6,8 +6,8 @@
 // on rtfuse/rec/info (format version, config, the device table: name, kind
 // and producing thread of every recorded bus). Then, in whatever order the
 // recorder drained its rings: one hal_can_t / hal_i2c_t / hal_gpio_t /
-// hal_clock_t per bus call, one hal_video_t per camera call (with the frame
-// bytes of a dequeue) on rtfuse/hal/<device name>, one loop_tick_t per
+// hal_clock_t / hal_serial_t per bus call, one hal_video_t per camera call
+// (with the frame bytes of a dequeue) on rtfuse/hal/<device name>, one loop_tick_t per
 // loop tick on rtfuse/rec/tick, and the published outputs on their own
 // channels. Events of one thread (stream) are in call order.
 //
@@ -56,7 +56,8 @@ constexpr int kVideoRecordOverhead = 256;
 // kVideo records hal_video_t (hal::VideoEvent), not BusEvents, through its
 // own ring, so a video device's stream holds no other device (the order of
 // two rings is not kept in the log).
-enum class DeviceKind : std::uint8_t { kCan, kI2c, kGpioEdge, kGpioOutput, kClock, kVideo };
+enum class DeviceKind : std::uint8_t { kCan, kI2c, kGpioEdge, kGpioOutput, kClock, kVideo, kSerial };
+constexpr DeviceKind kLastDeviceKind = DeviceKind::kSerial;
 const char* to_string(DeviceKind k) noexcept;
 // The bus call kinds a device of this kind records (none for kVideo).
 bool records(DeviceKind device, hal::BusEventKind call) noexcept;

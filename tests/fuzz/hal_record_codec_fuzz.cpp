@@ -1,7 +1,7 @@
 // Each record of a HAL recording on its own, as the codec decodes it: the
 // first byte picks the record type (recording_info_t, recording_file_t,
 // recording_end_t, loop_tick_t, the bus events of each device kind,
-// hal_video_t), the rest is the message. Property: a record is refused with
+// hal_video_t, hal_serial_t), the rest is the message. Property: a record is refused with
 // a message, or it is canonical: encoding what was decoded gives bytes that
 // decode again and encode to the same bytes.
 #include <cstddef>
@@ -20,7 +20,8 @@ namespace {
 std::vector<RecordedDevice> device_table() {
   return {{"can0", DeviceKind::kCan, 0},       {"i2c-1", DeviceKind::kI2c, 1},
           {"imu-drdy", DeviceKind::kGpioEdge, 1}, {"led", DeviceKind::kGpioOutput, 0},
-          {"loop-clock", DeviceKind::kClock, 0},  {"camera", DeviceKind::kVideo, 2}};
+          {"loop-clock", DeviceKind::kClock, 0},  {"camera", DeviceKind::kVideo, 2},
+          {"gnss0", DeviceKind::kSerial, 0}};
 }
 
 template <class Decode, class Encode>
@@ -44,7 +45,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   if (size < 1) return 0;
   static HalRecordCodec codec(device_table());
   static std::vector<std::uint8_t> buf(1 << 21);
-  const std::uint8_t which = data[0] % 10;
+  const std::uint8_t which = data[0] % 11;
   const std::uint8_t* msg = data + 1;
   const int n = static_cast<int>(size - 1);
   const int cap = static_cast<int>(buf.size());
@@ -120,8 +121,8 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
           [&](std::vector<std::uint8_t>* bytes) { return !bytes->empty(); });
       break;
     }
-    default: {  // 4..8: the bus devices
-      const std::uint8_t device = static_cast<std::uint8_t>(which - 4);
+    default: {  // 4..8 and 10: the bus devices (0..4, and the serial port 6)
+      const std::uint8_t device = static_cast<std::uint8_t>(which == 10 ? 6 : which - 4);
       const std::string channel(codec.channel(device));
       check_round_trip(
           msg, n,

@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "rtfuse/hal_can_t.hpp"
+#include "rtfuse/hal_serial_t.hpp"
 #include "rtfuse/recording_info_t.hpp"
 #include "support/alloc_counter.hpp"
 
@@ -42,7 +43,8 @@ RecordingInfo make_info() {
                   {"i2c-1", DeviceKind::kI2c, 1},
                   {"imu-drdy", DeviceKind::kGpioEdge, 1},
                   {"led", DeviceKind::kGpioOutput, 0},
-                  {"imu-clock", DeviceKind::kClock, 1}};
+                  {"imu-clock", DeviceKind::kClock, 1},
+                  {"gnss0", DeviceKind::kSerial, 0}};
   return info;
 }
 
@@ -141,6 +143,34 @@ std::vector<BusEvent> every_kind() {
   sleep.time_ns = 4'000'000'200;
   sleep.clock_ns = 4'005'000'000;
   evs.push_back(sleep);
+
+  BusEvent read;
+  read.kind = BusEventKind::kSerialRead;
+  read.device = 5;
+  read.time_ns = 5'000'000'000;
+  read.timeout_ns = 50'000'000;
+  read.length = 64;
+  read.count = 64;
+  read.edge_stamp = 4'999'999'000;
+  for (int i = 0; i < 64; ++i) read.data[i] = static_cast<std::uint8_t>(0xB5 + i);
+  evs.push_back(read);
+
+  BusEvent quiet;
+  quiet.kind = BusEventKind::kSerialRead;
+  quiet.device = 5;
+  quiet.timeout_ns = 50'000'000;
+  quiet.length = 64;
+  quiet.status = HalStatus::kTimeout;
+  evs.push_back(quiet);
+
+  BusEvent command;
+  command.kind = BusEventKind::kSerialWrite;
+  command.device = 5;
+  command.length = 3;
+  command.data[0] = 0xB5;
+  command.data[1] = 0x62;
+  command.data[2] = 0x06;
+  evs.push_back(command);
   return evs;
 }
 
@@ -162,7 +192,8 @@ TEST(HalRecordCodec, ChannelsAreNamedAfterTheDevices) {
   EXPECT_EQ(codec.channel(0), "rtfuse/hal/can0");
   EXPECT_EQ(codec.channel(1), "rtfuse/hal/i2c-1");
   EXPECT_EQ(codec.channel(4), "rtfuse/hal/imu-clock");
-  EXPECT_EQ(codec.channel(5), "");
+  EXPECT_EQ(codec.channel(5), "rtfuse/hal/gnss0");
+  EXPECT_EQ(codec.channel(6), "");
   EXPECT_EQ(codec.device_of("rtfuse/hal/imu-drdy"), 2);
   EXPECT_EQ(codec.device_of("rtfuse/hal/can1"), -1);
 }
@@ -213,6 +244,50 @@ TEST(HalRecordCodec, DecodeNamesWhatIsWrong) {
   m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
   EXPECT_FALSE(codec.decode("rtfuse/hal/can0", bytes.data(), static_cast<int>(bytes.size()), &out, &err));
   EXPECT_NE(err.find("names device 'can9'"), std::string::npos) << err;
+}
+
+TEST(HalRecordCodec, ImpossibleSerialRecordsAreNamed) {
+  HalRecordCodec codec(make_info().devices);
+  BusEvent out;
+  std::string err;
+  const auto decode = [&](const rtfuse::hal_serial_t& m) {
+    std::vector<std::uint8_t> bytes(static_cast<std::size_t>(m.getEncodedSize()));
+    m.encode(bytes.data(), 0, static_cast<int>(bytes.size()));
+    return codec.decode("rtfuse/hal/gnss0", bytes.data(), static_cast<int>(bytes.size()), &out, &err);
+  };
+  rtfuse::hal_serial_t m{};  // lcm-gen leaves scalars uninitialised
+  m.device = "gnss0";
+  m.call = rtfuse::hal_serial_t::READ;
+  m.length = 8;
+  m.num_data = 4;
+  m.data = {1, 2, 3, 4};
+  m.stamp_ns = 77;
+  ASSERT_TRUE(decode(m)) << err;
+  EXPECT_EQ(out.count, 4);
+  EXPECT_EQ(out.edge_stamp, 77);
+  m.length = 2;  // more bytes than asked for
+  EXPECT_FALSE(decode(m));
+  EXPECT_NE(err.find("impossible data byte count 4"), std::string::npos) << err;
+  m.length = 65;
+  EXPECT_FALSE(decode(m));
+  EXPECT_NE(err.find("impossible length 65"), std::string::npos) << err;
+  m.length = 8;
+  m.call = rtfuse::hal_serial_t::WRITE;  // a write of 8 bytes holding 4
+  EXPECT_FALSE(decode(m));
+  EXPECT_NE(err.find("data byte count"), std::string::npos) << err;
+  m.length = 4;
+  EXPECT_FALSE(decode(m));  // a stamp on a write
+  EXPECT_NE(err.find("stamp_ns"), std::string::npos) << err;
+  m.stamp_ns = 0;
+  m.timeout_ns = 5;
+  EXPECT_FALSE(decode(m));
+  EXPECT_NE(err.find("timeout_ns of a write"), std::string::npos) << err;
+  m.timeout_ns = 0;
+  ASSERT_TRUE(decode(m)) << err;
+  EXPECT_EQ(out.kind, BusEventKind::kSerialWrite);
+  m.call = 5;
+  EXPECT_FALSE(decode(m));
+  EXPECT_NE(err.find("impossible call 5"), std::string::npos) << err;
 }
 
 TEST(HalRecordCodec, AHugeFrameCountIsRefusedBeforeAnythingIsReserved) {
@@ -275,7 +350,8 @@ TEST(HalRecordingInfo, RoundTripsAndChecksTheVersion) {
   EXPECT_EQ(back.config_text, info.config_text);
   EXPECT_EQ(back.config_hash, config_text_hash("[loop]\nrate_hz = 200\n"));
   EXPECT_EQ(back.streams, info.streams);
-  ASSERT_EQ(back.devices.size(), 5u);
+  ASSERT_EQ(back.devices.size(), 6u);
+  EXPECT_EQ(back.devices[5].kind, DeviceKind::kSerial);
   EXPECT_EQ(back.devices[2].name, "imu-drdy");
   EXPECT_EQ(back.devices[2].kind, DeviceKind::kGpioEdge);
   EXPECT_EQ(back.devices[2].stream, 1);
@@ -363,9 +439,9 @@ TEST(HalRecordingLoader, SplitsEventsIntoStreamsTicksAndOutputs) {
   ASSERT_TRUE(load(log.path(), &rec, &err)) << err;
   EXPECT_EQ(rec.info.streams, make_info().streams);
   ASSERT_EQ(rec.streams.size(), 2u);
-  // loop: can0 (devices 0) and led (3); imu: i2c-1, imu-drdy, imu-clock.
+  // loop: can0 (devices 0), led (3) and gnss0 (5); imu: i2c-1, imu-drdy, imu-clock.
   std::vector<BusEvent> loop, imu;
-  for (const BusEvent& ev : evs) (ev.device == 0 || ev.device == 3 ? loop : imu).push_back(ev);
+  for (const BusEvent& ev : evs) (ev.device == 0 || ev.device == 3 || ev.device == 5 ? loop : imu).push_back(ev);
   ASSERT_EQ(rec.streams[0]->size(), loop.size());
   ASSERT_EQ(rec.streams[1]->size(), imu.size());
   for (std::size_t i = 0; i < loop.size(); ++i) EXPECT_EQ(rec.streams[0]->event(i), loop[i]) << i;
