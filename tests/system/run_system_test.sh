@@ -207,6 +207,7 @@ case "$mode" in
     [[ -f "$CONFIG_DIR/sim.toml" ]] || die "no config/sim.toml under CONFIG_DIR=$CONFIG_DIR"
     command -v lcm-logger >/dev/null || die "lcm-logger not found (package liblcm-bin)"
     command -v taskset >/dev/null || die "taskset not found (package util-linux)"
+    command -v chrt >/dev/null || die "chrt not found (package util-linux)"
     cp -r "$CONFIG_DIR" "$outdir/config"
     # The CPU everything runs on: the last this process may use (the suite's
     # other tests are not pinned, so they drift to the rest).
@@ -219,7 +220,12 @@ case "$mode" in
       sed -E 's/^diagnostics_rate = [0-9.]+/diagnostics_rate = 20/' "$CONFIG_DIR/sim.toml" >"$cfg"
       grep -q '^diagnostics_rate = 20' "$cfg" || die "could not set diagnostics_rate in $cfg"
       printf '\n[realtime]\npriority = %s\nio_priority = %s\nrequire = true\n' "$priority" "$io" >>"$cfg"
-      lcm-logger -q -f --lcm-url="$URL" --channel='rtfuse/diagnostics|rtfuse/odometry|sim/ground_truth' \
+      # The logger is the instrument, not the system under test: SCHED_FIFO
+      # (below rtfused's threads) so that other load on the machine (a build
+      # beside the suite) cannot make it drop the multicast it measures by
+      # (LCM filters channels after receiving the whole group, camera
+      # previews included).
+      chrt -f 60 lcm-logger -q -f --lcm-url="$URL" --channel='rtfuse/diagnostics|rtfuse/odometry|sim/ground_truth' \
         "$dir/run.lcm" >"$dir/lcm-logger.out" 2>&1 &
       logger=$!
       pids+=("$logger")
