@@ -2,6 +2,7 @@
 // Global filter parameters, robot_localization names in comments.
 #include <limits>
 
+#include "estimation/navsat_params.hpp"
 #include "estimation/sensor_sample.hpp"
 
 #include "estimation/state.hpp"
@@ -41,6 +42,7 @@ struct SensorParams {
   double linear_acceleration_rejection_threshold = std::numeric_limits<double>::infinity();
   bool remove_gravitational_acceleration = false;
   int queue_size = 10;                        // <sensor>_queue_size
+  NavsatParams navsat;                        // kNavSatFix: navsat_transform_node's
 };
 
 }  // namespace rtfuse::est

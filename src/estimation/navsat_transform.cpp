@@ -140,6 +140,12 @@ bool NavsatTransform::passes_jump_gate(TimeNs stamp, const Eigen::Vector3d& enu)
 
 NavsatRejection NavsatTransform::convert(TimeNs stamp, const NavSatFixSample& fix,
                                          const geometry::RigidTransform& world_T_base, PoseSample* out) noexcept {
+  last_ = judge(stamp, fix, world_T_base, out);
+  return last_;
+}
+
+NavsatRejection NavsatTransform::judge(TimeNs stamp, const NavSatFixSample& fix,
+                                       const geometry::RigidTransform& world_T_base, PoseSample* out) noexcept {
   if (fix.status < 0) {
     ++stats_.no_fix;
     return NavsatRejection::kNoFix;

@@ -23,38 +23,11 @@
 
 #include "core/time.hpp"
 #include "estimation/geodesy.hpp"
+#include "estimation/navsat_params.hpp"
 #include "estimation/sensor_sample.hpp"
 #include "geometry/rigid_transform.hpp"
 
 namespace rtfuse::est {
-
-struct NavsatParams {
-  double magnetic_declination_rad = 0.0;
-  double yaw_offset_rad = 0.0;
-  bool zero_altitude = false;
-  // wait_for_datum: the datum is this position and heading (in the IMU's
-  // convention, corrected like the IMU's), not the first fix; the world
-  // frame's origin is the datum and the robot is taken to stand there.
-  bool manual_datum = false;
-  GeodeticPosition datum;
-  double datum_yaw_rad = 0.0;
-  // Variances for a fix whose covariance type is unknown (m²).
-  double unknown_horizontal_variance = 4.0;
-  double unknown_vertical_variance = 16.0;
-  // A fix farther from the last accepted one than max_jump_m plus
-  // max_speed_mps times the time between them is a multipath jump or a
-  // corrupt position: rejected and counted. kReanchorFixes such fixes in a
-  // row that agree with each other are taken as the truth (the last accepted
-  // one was the outlier).
-  double max_jump_m = 25.0;
-  double max_speed_mps = 5.0;
-  // The antenna in base_link (the frame tree's base_link -> antenna frame).
-  Eigen::Vector3d base_p_antenna = Eigen::Vector3d::Zero();
-};
-
-// "" when usable, else the reason naming the key (the config loader adds
-// the file).
-const char* validate(const NavsatParams& p) noexcept;
 
 enum class NavsatRejection : std::uint8_t {
   kNone,
@@ -111,15 +84,20 @@ class NavsatTransform {
   NavSatFixSample filtered_fix(const Eigen::Vector3d& world_p_base, const Matrix3& world_covariance) const noexcept;
 
   const NavsatStats& stats() const noexcept { return stats_; }
+  // The verdict on the last fix (kNone before any).
+  NavsatRejection last() const noexcept { return last_; }
   const NavsatParams& params() const noexcept { return params_; }
 
  private:
+  NavsatRejection judge(TimeNs stamp, const NavSatFixSample& fix, const geometry::RigidTransform& world_T_base,
+                        PoseSample* out) noexcept;
   NavsatRejection covariance_of(const NavSatFixSample& fix, Matrix3* enu) const noexcept;
   bool passes_jump_gate(TimeNs stamp, const Eigen::Vector3d& enu) noexcept;
   void anchor(const Eigen::Vector3d& antenna_enu, const geometry::RigidTransform& world_T_base) noexcept;
 
   NavsatParams params_;
   NavsatStats stats_;
+  NavsatRejection last_ = NavsatRejection::kNone;
   LocalTangentPlane plane_;
   bool has_heading_ = false;
   Eigen::Quaterniond heading_ = Eigen::Quaterniond::Identity();  // IMU orientation, corrected yaw

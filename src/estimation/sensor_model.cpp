@@ -14,7 +14,11 @@ Matrix6 rotate_covariance6(const Matrix6& c, const Eigen::Matrix3d& r) noexcept 
 }
 
 SensorModel::SensorModel(std::uint8_t index, const SensorParams& sensor, const FilterParams& filter)
-    : index_(index), sensor_(sensor), two_d_(filter.two_d_mode), gravity_(filter.gravity) {}
+    : index_(index),
+      sensor_(sensor),
+      two_d_(filter.two_d_mode),
+      gravity_(filter.gravity),
+      navsat_(sensor.navsat) {}
 
 void SensorModel::reset() noexcept {
   has_reference_ = false;
@@ -91,6 +95,9 @@ SampleRejection SensorModel::convert(const SensorSample& s, const StateVector& s
     case SensorKind::kImu:
       if (sensor_.kind != SensorKind::kImu) return SampleRejection::kWrongKind;
       return convert_imu(s, state, frames, out);
+    case SensorKind::kNavSatFix:
+      if (sensor_.kind != SensorKind::kNavSatFix) return SampleRejection::kWrongKind;
+      return convert_navsat(s, state, out);
   }
   return SampleRejection::kWrongKind;
 }

@@ -8,6 +8,7 @@
 
 #include "estimation/filter_params.hpp"
 #include "estimation/measurement.hpp"
+#include "estimation/navsat_transform.hpp"
 #include "estimation/sensor_sample.hpp"
 #include "geometry/frame_tree.hpp"
 
@@ -17,6 +18,7 @@ enum class SampleRejection : std::uint8_t {
   kNone,
   kNoTransform,   // a frame the sample names is not connected to world/base_link
   kWrongKind,     // sample kind does not match the sensor's type
+  kNavsat,        // the navsat transform refused the fix (its stats say why)
 };
 
 struct FusionFrames {
@@ -44,6 +46,9 @@ class SensorModel {
 
   const SensorParams& params() const noexcept { return sensor_; }
   bool fuses_absolute_yaw() const noexcept;
+  // kNavSatFix: the transform, its heading source and its counters.
+  void set_navsat_heading(const Eigen::Quaterniond& base_orientation) noexcept { navsat_.set_heading(base_orientation); }
+  const NavsatTransform& navsat() const noexcept { return navsat_; }
   void set_yaw_gate(double sigma) noexcept { yaw_gate_sigma_ = sigma; }
 
  private:
@@ -58,6 +63,7 @@ class SensorModel {
                                 const FusionFrames& f, MeasurementBatch* out) noexcept;
   SampleRejection convert_imu(const SensorSample& s, const StateVector& state, const FusionFrames& f,
                               MeasurementBatch* out) noexcept;
+  SampleRejection convert_navsat(const SensorSample& s, const StateVector& state, MeasurementBatch* out) noexcept;
   // Relative/differential handling shared by pose sources and IMU orientation.
   void pose_part(TimeNs stamp, const WorldPose& pose, UpdateMask mask, MeasurementBatch* out) noexcept;
   Measurement blank(TimeNs stamp, MeasurementPart part) const noexcept;
@@ -74,6 +80,8 @@ class SensorModel {
   bool has_previous_ = false;        // differential: the previous pose
   WorldPose previous_;
   TimeNs previous_stamp_ = 0;
+
+  NavsatTransform navsat_;  // kNavSatFix only
 
 };
 

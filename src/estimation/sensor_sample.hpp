@@ -13,7 +13,7 @@
 
 namespace rtfuse::est {
 
-enum class SensorKind : std::uint8_t { kOdometry, kPose, kTwist, kImu };
+enum class SensorKind : std::uint8_t { kOdometry, kPose, kTwist, kImu, kNavSatFix };
 
 struct PoseSample {
   Eigen::Vector3d position = Eigen::Vector3d::Zero();
@@ -58,6 +58,7 @@ struct SensorSample {
   PoseSample pose;    // kOdometry, kPose
   TwistSample twist;  // kOdometry, kTwist
   ImuSample imu;      // kImu
+  NavSatFixSample navsat;  // kNavSatFix
 };
 
 }  // namespace rtfuse::est

@@ -14,6 +14,8 @@
 namespace rtfuse {
 
 constexpr int kMaxSensors = 16;
+// GNSS receivers a robot carries (a dual-antenna set-up at most).
+constexpr int kMaxNavsatSensors = 2;
 constexpr int kMaxStaticTransforms = 24;
 
 using Name = FixedString<63>;
@@ -31,6 +33,12 @@ struct SensorConfig {
   // queue_size, allowed) are dropped before decoding and counted. The loader
   // resolves an absent key to what the loop drains, 2 x queue_size per tick.
   double max_rate_hz = 0.0;
+  // type "navsat": the antenna's frame (its lever arm from base_link; empty:
+  // at base_link's origin) and the IMU sensor whose orientation gives the
+  // datum's heading (-1: the filter's own yaw or a configured datum).
+  Name antenna_frame;
+  Name heading_imu;
+  int heading_sensor = -1;
 };
 
 struct StaticTransformConfig {

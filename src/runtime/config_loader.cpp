@@ -1,5 +1,6 @@
 #include "runtime/config_loader.hpp"
 
+#include <algorithm>
 #include <array>
 #include <cerrno>
 #include <cmath>
@@ -187,6 +188,7 @@ std::optional<est::SensorKind> parse_kind(std::string_view t) {
   if (t == "pose") return est::SensorKind::kPose;
   if (t == "twist") return est::SensorKind::kTwist;
   if (t == "imu") return est::SensorKind::kImu;
+  if (t == "navsat") return est::SensorKind::kNavSatFix;
   return std::nullopt;
 }
 
@@ -196,6 +198,7 @@ std::string_view kind_name(est::SensorKind k) {
     case est::SensorKind::kPose: return "pose";
     case est::SensorKind::kTwist: return "twist";
     case est::SensorKind::kImu: return "imu";
+    case est::SensorKind::kNavSatFix: return "navsat";
   }
   return "?";
 }
@@ -209,6 +212,9 @@ UpdateMask providable(est::SensorKind k) {
     case est::SensorKind::kTwist: return est::kTwistMask;
     case est::SensorKind::kImu:
       return est::kOrientationMask | est::kAngularVelocityMask | est::kAccelerationMask;
+    // A fix is a position: navsat_transform_node's odometry/gps has no
+    // meaningful orientation or velocity.
+    case est::SensorKind::kNavSatFix: return est::kPositionMask;
   }
   return 0;
 }
@@ -246,6 +252,52 @@ std::optional<UpdateMask> read_mask(const Section& s, std::string_view k) {
   return mask;
 }
 
+constexpr std::string_view kNavsatKeys[] = {"frame",      "heading_imu",        "use_odometry_yaw",
+                                            "magnetic_declination_radians", "yaw_offset", "zero_altitude",
+                                            "datum",      "unknown_covariance", "max_jump", "max_speed"};
+
+// navsat_transform_node's parameters on the sensor (robot_localization's
+// names where it has them). The datum's heading needs a source: an IMU
+// sensor, the filter's own yaw, or a configured datum.
+void read_navsat(const Section& s, SensorConfig& c) {
+  est::NavsatParams& n = c.params.navsat;
+  if (s.has("frame")) s.read_name("frame", c.antenna_frame);
+  if (s.has("heading_imu")) s.read_name("heading_imu", c.heading_imu);
+  s.read("use_odometry_yaw", n.use_filter_yaw);
+  const auto finite_angle = [](double v) { return std::isfinite(v) && std::fabs(v) <= 6.3; };
+  read_number(s, "magnetic_declination_radians", n.magnetic_declination_rad, finite_angle,
+              "must be finite, within ±2π rad");
+  read_number(s, "yaw_offset", n.yaw_offset_rad, finite_angle, "must be finite, within ±2π rad");
+  s.read("zero_altitude", n.zero_altitude);
+  if (const auto d = read_fixed(s, "datum", 3, "latitude (deg) longitude (deg) yaw (rad)")) {
+    n.manual_datum = true;
+    n.datum = {(*d)[0], (*d)[1], 0.0};
+    n.datum_yaw_rad = (*d)[2];
+    if (!est::is_valid_geodetic(n.datum)) {
+      s.key_error("datum", "latitude must be within ±90 and longitude within ±180 degrees, got " +
+                               std::to_string((*d)[0]) + ", " + std::to_string((*d)[1]));
+    } else if (!finite_angle(n.datum_yaw_rad)) {
+      s.key_error("datum", "yaw must be finite, within ±2π rad");
+    }
+  }
+  if (const auto v = read_fixed(s, "unknown_covariance", 2, "horizontal vertical (m²)")) {
+    n.unknown_horizontal_variance = (*v)[0];
+    n.unknown_vertical_variance = (*v)[1];
+    if (!(positive_finite((*v)[0]) && positive_finite((*v)[1]))) {
+      s.key_error("unknown_covariance", "both variances must be > 0 and finite (m²)");
+    }
+  }
+  read_number(s, "max_jump", n.max_jump_m, positive_finite, "must be > 0 m and finite");
+  read_number(s, "max_speed", n.max_speed_mps, non_negative_finite, "must be >= 0 m/s and finite");
+  const int heading_sources = (c.heading_imu.empty() ? 0 : 1) + (n.use_filter_yaw ? 1 : 0) + (n.manual_datum ? 1 : 0);
+  if (heading_sources == 0) {
+    s.key_error("heading_imu", "the datum needs a heading: name an imu sensor (heading_imu), set "
+                               "use_odometry_yaw = true, or give datum = [latitude, longitude, yaw]");
+  } else if (heading_sources > 1) {
+    s.key_error("heading_imu", "give one heading source: heading_imu, use_odometry_yaw or datum");
+  }
+}
+
 struct SensorEntry {
   SensorConfig cfg;
   bool has_name = false;
@@ -255,7 +307,9 @@ struct SensorEntry {
 SensorEntry read_sensor(const Section& s) {
   s.reject_unknown({"name", "type", "channel", "source", "config", "differential", "relative", "queue_size",
                     "pose_rejection_threshold", "twist_rejection_threshold",
-                    "linear_acceleration_rejection_threshold", "remove_gravitational_acceleration", "max_rate"});
+                    "linear_acceleration_rejection_threshold", "remove_gravitational_acceleration", "max_rate",
+                    "frame", "heading_imu", "use_odometry_yaw", "magnetic_declination_radians", "yaw_offset",
+                    "zero_altitude", "datum", "unknown_covariance", "max_jump", "max_speed"});
   s.require({"name", "type"});
   SensorEntry e;
   est::SensorParams& p = e.cfg.params;
@@ -294,7 +348,7 @@ SensorEntry read_sensor(const Section& s) {
     if (kind) {
       p.kind = *kind;
     } else {
-      s.value_error("type", "must be one of odometry, pose, twist, imu, got " + in_quotes(type));
+      s.value_error("type", "must be one of odometry, pose, twist, imu, navsat, got " + in_quotes(type));
     }
   }
 
@@ -329,6 +383,13 @@ SensorEntry read_sensor(const Section& s) {
       if (s.has(k)) s.key_error(k, "only valid for type 'imu'");
     }
   }
+  if (kind && *kind == est::SensorKind::kNavSatFix) {
+    read_navsat(s, e.cfg);
+  } else if (kind) {
+    for (std::string_view k : kNavsatKeys) {
+      if (s.has(k)) s.key_error(k, "only valid for type 'navsat'");
+    }
+  }
   return e;
 }
 
@@ -357,10 +418,42 @@ void read_sensors(const Section& root, RuntimeConfig& cfg, const std::vector<Cha
         break;
       }
     }
+    if (e.cfg.params.kind == est::SensorKind::kNavSatFix) {
+      int navsat = 0;
+      for (int j = 0; j < cfg.num_sensors; ++j) {
+        if (cfg.sensors[static_cast<std::size_t>(j)].params.kind == est::SensorKind::kNavSatFix) ++navsat;
+      }
+      if (navsat == kMaxNavsatSensors) {
+        s.value_error("type", "at most " + std::to_string(kMaxNavsatSensors) + " navsat sensors");
+      }
+    }
     // Unnamed entries are still stored (the config is rejected anyway) so
     // that "also sensor[j]" indices match the file.
     if (fits) cfg.sensors[static_cast<std::size_t>(cfg.num_sensors++)] = e.cfg;
   });
+  // A navsat sensor's heading IMU, by name, once every sensor is known (the
+  // stored sensors are the array's tables within kMaxSensors, in order).
+  const toml::array* entries = config::table_array(root, "sensor");
+  int index = 0;
+  for (std::size_t i = 0; entries != nullptr && i < entries->size() && index < cfg.num_sensors; ++i) {
+    const auto* t = entries->get(i)->as_table();
+    if (t == nullptr) continue;
+    const Section s(t, root.key("sensor") + "[" + std::to_string(i) + "]", root.diag());
+    SensorConfig& c = cfg.sensors[static_cast<std::size_t>(index++)];
+    if (c.heading_imu.empty()) continue;
+    for (int j = 0; j < cfg.num_sensors && c.heading_sensor < 0; ++j) {
+      const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];
+      if (o.name != c.heading_imu) continue;
+      if (o.params.kind != est::SensorKind::kImu || !est::mask_has(o.params.update_mask, est::kYaw)) {
+        s.value_error("heading_imu", in_quotes(c.heading_imu.view()) + " is not an imu sensor that fuses yaw");
+        break;
+      }
+      c.heading_sensor = j;
+    }
+    const bool named = std::any_of(cfg.sensors.begin(), cfg.sensors.begin() + cfg.num_sensors,
+                                   [&](const SensorConfig& o) { return o.name == c.heading_imu; });
+    if (!named) s.value_error("heading_imu", "no sensor is named " + in_quotes(c.heading_imu.view()));
+  }
 }
 
 void read_static_transform(const Section& s, StaticTransformConfig& out) {

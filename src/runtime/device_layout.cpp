@@ -37,6 +37,13 @@ const char* const kVoKeys[] = {"pairs",      "motions",      "fps_milli",   "ski
                                "residual_milli_px", "time_us", "max_time_us", "latency_us"};
 const int kVoKeyCount = sizeof(kVoKeys) / sizeof(kVoKeys[0]);
 static_assert(sizeof(kVoKeys) / sizeof(kVoKeys[0]) <= kMaxDeviceValues, "more VO keys than a device holds");
+// The navsat transform's refusals by reason (est::NavsatStats).
+const char* const kNavsatKeys[] = {"accepted", "no_fix",        "invalid_position", "invalid_covariance",
+                                   "waiting_for_heading", "jumps", "reanchors"};
+const int kNavsatKeyCount = sizeof(kNavsatKeys) / sizeof(kNavsatKeys[0]);
+// Every slot a configuration can ask for: CAN bus and nodes, wheel
+// odometry, IMU, camera, VO, a GNSS receiver, the navsat transforms.
+static_assert(1 + kMaxWheelNodes + 4 + 1 + kMaxNavsatSensors <= kMaxDevices, "kMaxDevices is too small");
 static_assert(sizeof(kCameraKeys) / sizeof(kCameraKeys[0]) <= kMaxDeviceValues, "more camera keys than a device holds");
 static_assert(sizeof(kImuKeys) / sizeof(kImuKeys[0]) <= kMaxDeviceValues, "more IMU keys than a device holds");
 static_assert(sizeof(kEncoderNodeKeys) / sizeof(kEncoderNodeKeys[0]) <= kMaxDeviceValues,
@@ -55,6 +62,13 @@ DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
   if (hw.mpu.enabled) s.imu = s.count++;
   if (hw.camera.enabled) s.camera = s.count++;
   if (hw.camera.enabled && hw.vo.enabled && hw.vo_sensor >= 0) s.vo = s.count++;
+  for (int i = 0; i < cfg.num_sensors; ++i) {
+    if (cfg.sensors[static_cast<std::size_t>(i)].params.kind != est::SensorKind::kNavSatFix) continue;
+    if (s.num_navsat == kMaxNavsatSensors) break;  // the loader refuses more
+    if (s.first_navsat < 0) s.first_navsat = s.count;
+    ++s.num_navsat;
+    ++s.count;
+  }
   return s;
 }
 
@@ -115,6 +129,16 @@ int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexc
     std::snprintf(buf, sizeof buf, "%s %s", hw.camera.device.c_str(), hw.camera.frame.c_str());
     d.hardware_id = buf;
     keys(d, kVoKeys, kVoKeyCount);
+  }
+  int k = 0;
+  for (int i = 0; i < cfg.num_sensors && k < slots.num_navsat; ++i) {
+    const SensorConfig& c = cfg.sensors[static_cast<std::size_t>(i)];
+    if (c.params.kind != est::SensorKind::kNavSatFix) continue;
+    DeviceStatus& d = out[slots.first_navsat + k++];
+    std::snprintf(buf, sizeof buf, "navsat %s", c.name.c_str());
+    d.name = buf;
+    d.hardware_id = c.channel.empty() ? c.name.c_str() : c.channel.c_str();
+    keys(d, kNavsatKeys, kNavsatKeyCount);
   }
   return slots.count;
 }

@@ -10,7 +10,7 @@
 
 namespace rtfuse {
 
-constexpr int kMaxDevices = 12;
+constexpr int kMaxDevices = 16;
 constexpr int kMaxDeviceValues = 20;
 
 enum class DeviceLevel : std::int8_t { kOk = 0, kWarn = 1, kError = 2, kStale = 3 };

@@ -1,6 +1,7 @@
 #include "runtime/fusion_core.hpp"
 
 #include <cmath>
+#include <cstdio>
 
 #include "geometry/rotation.hpp"
 
@@ -9,6 +10,7 @@ namespace rtfuse {
 std::unique_ptr<FusionCore> FusionCore::create(const RuntimeConfig& cfg, std::string* error) {
   std::unique_ptr<FusionCore> core(new FusionCore(cfg));
   if (!core->build_frames(error)) return nullptr;
+  if (!core->configure_navsat(error)) return nullptr;
   core->input_ = std::make_unique<InputRouter>(core->cfg_, core->frames_);
   return core;
 }
@@ -54,6 +56,89 @@ bool FusionCore::build_frames(std::string* error) {
   return true;
 }
 
+bool FusionCore::configure_navsat(std::string* error) {
+  for (int i = 0; i < cfg_.num_sensors; ++i) {
+    SensorConfig& c = cfg_.sensors[i];
+    if (c.params.kind != est::SensorKind::kNavSatFix) continue;
+    const std::string where = cfg_.source + ": sensor '" + std::string(c.name.view()) + "'";
+    if (!c.antenna_frame.empty()) {
+      const auto base_T_antenna = frames_.lookup(cfg_.base_link_frame.view(), c.antenna_frame.view());
+      if (!base_T_antenna) {
+        *error = where + ": frame '" + std::string(c.antenna_frame.view()) + "' is not connected to '" +
+                 std::string(cfg_.base_link_frame.view()) + "': add a [[static_transform]] with parent = '" +
+                 std::string(cfg_.base_link_frame.view()) + "' and child = '" + std::string(c.antenna_frame.view()) +
+                 "' (the antenna's mounting)";
+        return false;
+      }
+      c.params.navsat.base_p_antenna = base_T_antenna->translation;
+    }
+    const char* why = est::validate(c.params.navsat);
+    if (why[0] != '\0') {
+      *error = where + ": " + why;
+      return false;
+    }
+    models_[i] = est::SensorModel(static_cast<std::uint8_t>(i), c.params, cfg_.filter);
+    if (c.heading_sensor >= 0) heading_targets_[c.heading_sensor] |= 1u << i;
+  }
+  slots_ = device_slots(cfg_);
+  if (slots_.num_navsat > 0) {
+    const auto layout = std::make_unique<DeviceStatus[]>(kMaxDevices);
+    describe_devices(cfg_, layout.get(), kMaxDevices);
+    int k = 0;
+    for (int i = 0; i < cfg_.num_sensors && k < slots_.num_navsat; ++i) {
+      if (cfg_.sensors[i].params.kind != est::SensorKind::kNavSatFix) continue;
+      navsat_layout_[k] = layout[slots_.first_navsat + k];
+      navsat_sensor_[k++] = i;
+    }
+  }
+  return true;
+}
+
+void FusionCore::fill_navsat(Snapshot& s) const noexcept {
+  if (slots_.num_navsat == 0) return;
+  if (s.num_devices < slots_.count) s.num_devices = slots_.count;
+  for (int k = 0; k < slots_.num_navsat; ++k) {
+    DeviceStatus& d = s.devices[slots_.first_navsat + k];
+    d.name = navsat_layout_[k].name;
+    d.hardware_id = navsat_layout_[k].hardware_id;
+    const est::NavsatTransform& n = models_[navsat_sensor_[k]].navsat();
+    const est::NavsatStats& st = n.stats();
+    set_device_values(d, kNavsatKeys, kNavsatKeyCount,
+                      {st.accepted, st.no_fix, st.invalid_position, st.invalid_covariance, st.waiting_for_heading,
+                       st.jumps, st.reanchors});
+    if (!n.has_transform()) {
+      d.state = n.has_heading() || n.params().use_filter_yaw ? "waiting for a fix" : "waiting for a heading";
+      d.level = DeviceLevel::kStale;
+    } else {
+      d.state = "datum set";
+      d.level = n.last() == est::NavsatRejection::kNone ? DeviceLevel::kOk : DeviceLevel::kWarn;
+    }
+    if (n.last() != est::NavsatRejection::kNone) {
+      char text[96];
+      std::snprintf(text, sizeof text, "last fix refused: %s", est::to_string(n.last()));
+      set_device_message(d.message, text);
+    } else if (n.has_transform()) {
+      char text[96];
+      std::snprintf(text, sizeof text, "datum %.7f %.7f %.2f m", n.plane().datum().latitude_deg,
+                    n.plane().datum().longitude_deg, n.plane().datum().altitude_m);
+      set_device_message(d.message, text);
+    }
+  }
+}
+
+void FusionCore::feed_navsat_heading(const est::SensorSample& s) noexcept {
+  // navsat_transform_node's imuCallback: the IMU's orientation, its
+  // mounting taken off, until the datum is fixed.
+  const auto base_T_imu = frames_.lookup(fusion_frames_.base_link, s.frame);
+  if (!base_T_imu) return;
+  const Eigen::Quaterniond base_orientation = s.imu.orientation * base_T_imu->rotation.conjugate();
+  for (int j = 0; j < cfg_.num_sensors; ++j) {
+    if ((heading_targets_[s.sensor] & (1u << j)) != 0 && !models_[j].navsat().has_transform()) {
+      models_[j].set_navsat_heading(base_orientation);
+    }
+  }
+}
+
 void FusionCore::apply_set_pose(const SetPoseCommand& cmd) noexcept {
   const auto world_T_frame = frames_.lookup(fusion_frames_.world, cmd.frame);
   if (!world_T_frame) {
@@ -91,6 +176,9 @@ void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
   }
   st.last_stamp_ns = s.stamp;
   last_arrival_[s.sensor] = now;
+  if (s.kind == est::SensorKind::kImu && s.imu.has_orientation && heading_targets_[s.sensor] != 0) {
+    feed_navsat_heading(s);
+  }
 
   est::MeasurementBatch batch;
   if (models_[s.sensor].convert(s, filter_->state_at(s.stamp), fusion_frames_, &batch) != est::SampleRejection::kNone) {
@@ -186,6 +274,7 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
   s.num_devices = 0;
   s.wheel_odometry.valid = false;
   if (devices_ != nullptr) devices_->fill_snapshot(s);
+  fill_navsat(s);
   snapshot_.store(s);
 }
 

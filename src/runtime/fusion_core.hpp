@@ -9,6 +9,7 @@
 #include "estimation/sensor_model.hpp"
 #include "geometry/frame_tree.hpp"
 #include "runtime/config.hpp"
+#include "runtime/device_layout.hpp"
 #include "runtime/input_router.hpp"
 #include "runtime/snapshot.hpp"
 
@@ -51,9 +52,14 @@ class FusionCore {
  private:
   explicit FusionCore(const RuntimeConfig& cfg);
   bool build_frames(std::string* error);
+  // navsat sensors: lever arms from the frame tree, heading IMUs.
+  bool configure_navsat(std::string* error);
+  void feed_navsat_heading(const est::SensorSample& s) noexcept;
   void apply_set_pose(const SetPoseCommand& cmd) noexcept;
   void fuse(const est::SensorSample& s, TimeNs now) noexcept;
   void publish_snapshot(TimeNs now, const LoopStats& loop) noexcept;
+  // The navsat transforms' slots of the diagnostics.
+  void fill_navsat(Snapshot& s) const noexcept;
 
   RuntimeConfig cfg_;
   geometry::FrameTree frames_;
@@ -63,6 +69,12 @@ class FusionCore {
   est::SensorModel models_[kMaxSensors];
   SensorStats stats_[kMaxSensors];
   TimeNs last_arrival_[kMaxSensors] = {};
+  // Per sensor: the navsat sensors (bit j) whose datum heading it gives.
+  std::uint32_t heading_targets_[kMaxSensors] = {};
+  DeviceSlots slots_;
+  int navsat_sensor_[kMaxNavsatSensors] = {};
+  DeviceStatus navsat_layout_[kMaxNavsatSensors];  // names and ids
+  static_assert(kMaxSensors <= 32, "heading_targets_ is a bit set");
   std::unique_ptr<est::SensorSample[]> staging_;
   int staging_capacity_ = 0;
   std::int64_t set_pose_count_ = 0;

@@ -221,6 +221,7 @@ SampleDecoder::SampleDecoder(const geometry::FrameTree& frames) : frames_(frames
   imu_.header.frame_id.reserve(kStringReserve);
   pose_.header.frame_id.reserve(kStringReserve);
   twist_.header.frame_id.reserve(kStringReserve);
+  navsat_.header.frame_id.reserve(kStringReserve);
 }
 
 std::int16_t SampleDecoder::resolve(const std::string& frame_id) const {
@@ -235,6 +236,7 @@ DecodeResult SampleDecoder::decode(est::SensorKind kind, const void* data, int s
     case est::SensorKind::kImu: return decode_imu(data, size, out);
     case est::SensorKind::kPose: return decode_pose(data, size, out);
     case est::SensorKind::kTwist: return decode_twist(data, size, out);
+    case est::SensorKind::kNavSatFix: return decode_navsat(data, size, out);
   }
   return DecodeResult::kWrongType;
 }
@@ -286,6 +288,21 @@ DecodeResult SampleDecoder::decode_twist(const void* data, int size, est::Sensor
   if (r != DecodeResult::kOk) return r;
   reset_sample(out, est::SensorKind::kTwist, twist_.header.utime, frame, -1);
   out->twist = to_twist(twist_.twist);
+  return DecodeResult::kOk;
+}
+
+DecodeResult SampleDecoder::decode_navsat(const void* data, int size, est::SensorSample* out) {
+  const DecodeResult r = decode_bytes(navsat_, data, size, 1);
+  if (r != DecodeResult::kOk) return r;
+  // The antenna's frame is the sensor's configured one (its lever arm is
+  // fixed at configuration); an unknown or empty frame_id is no reason to
+  // lose the fix, as navsat_transform_node takes it too.
+  reset_sample(out, est::SensorKind::kNavSatFix, navsat_.header.utime, resolve(navsat_.header.frame_id), -1);
+  est::NavSatFixSample& f = out->navsat;
+  f.status = navsat_.status;
+  f.covariance_type = static_cast<std::uint8_t>(navsat_.position_covariance_type);
+  f.position = {navsat_.latitude, navsat_.longitude, navsat_.altitude};
+  f.covariance = to_matrix<3>(navsat_.position_covariance);
   return DecodeResult::kOk;
 }
 

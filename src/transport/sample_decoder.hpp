@@ -10,6 +10,7 @@
 #include "estimation/sensor_sample.hpp"
 #include "geometry/frame_tree.hpp"
 #include "rtfuse/imu_t.hpp"
+#include "rtfuse/navsat_fix_t.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/twist_with_covariance_stamped_t.hpp"
@@ -35,7 +36,10 @@ class SampleDecoder {
   explicit SampleDecoder(const geometry::FrameTree& frames);
 
   // kind selects the expected type: kOdometry odometry_t, kImu imu_t, kPose
-  // pose_with_covariance_stamped_t, kTwist twist_with_covariance_stamped_t.
+  // pose_with_covariance_stamped_t, kTwist twist_with_covariance_stamped_t,
+  // kNavSatFix navsat_fix_t. A fix's values are passed on as they are: the
+  // navsat transform judges them (status, NaN, range, covariance type) and
+  // counts each refusal by its reason.
   // *out is written only on kOk, and then entirely except out->sensor, which
   // belongs to the caller; the parts the kind does not use are reset.
   DecodeResult decode(est::SensorKind kind, const void* data, int size, est::SensorSample* out);
@@ -50,6 +54,7 @@ class SampleDecoder {
   DecodeResult decode_imu(const void* data, int size, est::SensorSample* out);
   DecodeResult decode_pose(const void* data, int size, est::SensorSample* out);
   DecodeResult decode_twist(const void* data, int size, est::SensorSample* out);
+  DecodeResult decode_navsat(const void* data, int size, est::SensorSample* out);
   // Index of a known frame, -1 for an empty or unknown id.
   std::int16_t resolve(const std::string& frame_id) const;
 
@@ -58,6 +63,7 @@ class SampleDecoder {
   rtfuse::odometry_t odometry_{};
   rtfuse::imu_t imu_{};
   rtfuse::pose_with_covariance_stamped_t pose_{};
+  rtfuse::navsat_fix_t navsat_{};
   rtfuse::twist_with_covariance_stamped_t twist_{};
 };
 

@@ -3,8 +3,9 @@
 // its visual odometry) and the loop, publisher and LCM threads of rtfused,
 // plus one LCM sensor of each type and set_pose accepted. Each input is one
 // message, published on memq:// to the daemon's own LCM node while it runs:
-// the first byte picks the channel (odometry, pose, twist, IMU, set_pose, as
-// in sample_decoder_fuzz.cpp, whose seeds serve here), the rest is the bytes.
+// the first byte picks the channel (odometry, pose, twist, IMU, set_pose,
+// navsat fix, as in sample_decoder_fuzz.cpp, whose seeds serve here), the
+// rest is the bytes.
 // Property: no crash or sanitizer report in any thread, every published
 // odometry and pose finite, and the daemon still publishing at the end.
 #include <atomic>
@@ -29,7 +30,9 @@
 
 namespace {
 
-constexpr const char* kChannels[] = {"fuzz/odometry", "fuzz/pose", "fuzz/twist", "fuzz/imu", "rtfuse/set_pose"};
+constexpr const char* kChannels[] = {"fuzz/odometry", "fuzz/pose", "fuzz/twist", "fuzz/imu", "rtfuse/set_pose",
+                                     "fuzz/navsat"};
+constexpr int kNumChannels = sizeof(kChannels) / sizeof(kChannels[0]);
 
 // Every kind of LCM sensor, each fusing what its type provides.
 constexpr const char* kFuzzSensors = R"(
@@ -56,6 +59,13 @@ name = "fuzz_imu"
 type = "imu"
 channel = "fuzz/imu"
 config = [false, false, false, true, true, true, false, false, false, true, true, true, true, true, true]
+
+[[sensor]]
+name = "fuzz_navsat"
+type = "navsat"
+channel = "fuzz/navsat"
+config = [true, true, true, false, false, false, false, false, false, false, false, false, false, false, false]
+heading_imu = "fuzz_imu"
 )";
 
 struct Daemon {
@@ -179,7 +189,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1 || size > (1u << 16)) return 0;
   Daemon& d = *g_daemon;
-  const char* channel = kChannels[data[0] % 5];
+  const char* channel = kChannels[data[0] % kNumChannels];
   FUZZ_CHECK(d.runtime->lcm().publish(channel, data + 1, static_cast<int>(size - 1)), "memq publish");
   ++d.published;
   // memq:// queues without bound: keep at most 256 messages ahead of the

@@ -17,6 +17,7 @@
 #include <vector>
 
 #include "rtfuse/imu_t.hpp"
+#include "rtfuse/navsat_fix_t.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/twist_with_covariance_stamped_t.hpp"
@@ -86,12 +87,23 @@ int main(int argc, char** argv) {
   twist.header.frame_id = "base_link";
   twist.twist.twist.angular.z = 0.1;
   fill_covariance(twist.twist.covariance, 6, 0.01);
-  // The harness's selector: 0 odometry, 1 pose, 2 twist, 3 imu, 4 set_pose.
+  rtfuse::navsat_fix_t fix{};
+  fix.header = odom.header;
+  fix.header.frame_id = "gps";
+  fix.status = rtfuse::navsat_fix_t::STATUS_FIX;
+  fix.latitude = 47.3977;
+  fix.longitude = 8.5456;
+  fix.altitude = 488.0;
+  fill_covariance(fix.position_covariance, 3, 1.0);
+  fix.position_covariance_type = rtfuse::navsat_fix_t::COVARIANCE_TYPE_DIAGONAL_KNOWN;
+  // The harness's selector: 0 odometry, 1 pose, 2 twist, 3 imu, 4 set_pose,
+  // 5 navsat fix.
   write_file(dir + "/sample_decoder/odometry", encode(odom), 0, true);
   write_file(dir + "/sample_decoder/pose", encode(pose), 1, true);
   write_file(dir + "/sample_decoder/twist", encode(twist), 2, true);
   write_file(dir + "/sample_decoder/imu", encode(imu), 3, true);
   write_file(dir + "/sample_decoder/set_pose", encode(pose), 4, true);
+  write_file(dir + "/sample_decoder/navsat_fix", encode(fix), 5, true);
   // In the world frame of config/sim.toml, so daemon_input_fuzz (which
   // shares these seeds) starts with a set_pose the filter applies.
   pose.header.frame_id = "odom";
@@ -108,7 +120,8 @@ int main(int argc, char** argv) {
   info.streams = {"loop", "imu", "camera"};
   info.devices = {{"can0", DeviceKind::kCan, 0},       {"i2c-1", DeviceKind::kI2c, 1},
                   {"imu-drdy", DeviceKind::kGpioEdge, 1}, {"led", DeviceKind::kGpioOutput, 0},
-                  {"loop-clock", DeviceKind::kClock, 0},  {"camera", DeviceKind::kVideo, 2}};
+                  {"loop-clock", DeviceKind::kClock, 0},  {"camera", DeviceKind::kVideo, 2},
+                  {"gnss0", DeviceKind::kSerial, 0}};
   info.files = {{"camera.calibration", "/etc/rtfuse/SN1.conf", "[STEREO]\nBaseline=120\n"}};
   HalRecordCodec codec(info.devices);
 
@@ -129,7 +142,7 @@ int main(int argc, char** argv) {
       std::exit(1);
     }
     add(codec.channel(ev.device), std::vector<std::uint8_t>(buf.begin(), buf.begin() + n),
-        static_cast<std::uint8_t>(4 + ev.device));
+        static_cast<std::uint8_t>(ev.device == 6 ? 10 : 4 + ev.device));
   };
   TimeNs t = info.start_ns;
   hal::BusEvent ev{};
@@ -164,6 +177,21 @@ int main(int argc, char** argv) {
   bus_event(ev);
   ev = {};
   ev.kind = hal::BusEventKind::kClockSleepUntil, ev.device = 4, ev.time_ns = t + 6000, ev.clock_ns = t + 5'000'000;
+  bus_event(ev);
+  // A GNSS receiver's UART: a read with the start of a UBX frame, a quiet
+  // read, and a command written.
+  ev = {};
+  ev.kind = hal::BusEventKind::kSerialRead, ev.device = 6, ev.time_ns = t + 6500, ev.timeout_ns = 50'000'000;
+  ev.length = 64, ev.count = 6, ev.edge_stamp = t + 6400;
+  ev.data[0] = 0xB5, ev.data[1] = 0x62, ev.data[2] = 0x01, ev.data[3] = 0x07, ev.data[4] = 92, ev.data[5] = 0;
+  bus_event(ev);
+  ev = {};
+  ev.kind = hal::BusEventKind::kSerialRead, ev.device = 6, ev.time_ns = t + 6600, ev.timeout_ns = 50'000'000;
+  ev.length = 64, ev.status = hal::HalStatus::kTimeout;
+  bus_event(ev);
+  ev = {};
+  ev.kind = hal::BusEventKind::kSerialWrite, ev.device = 6, ev.time_ns = t + 6700, ev.length = 2;
+  ev.data[0] = 0xB5, ev.data[1] = 0x62;
   bus_event(ev);
 
   // A camera: start, one 4x2 grey frame dequeued and released.

@@ -1,12 +1,16 @@
 // The LCM input decoders (odometry_t, imu_t, pose and twist with covariance,
-// the set_pose command): bytes from anyone on the multicast group. The first
-// byte picks the decoder. Property: a message is rejected with a reason, or
-// everything it hands to the filter is finite with a unit-norm orientation
-// and a known frame: no NaN ever reaches the estimate through here.
+// the set_pose command, navsat_fix_t): bytes from anyone on the multicast
+// group. The first byte picks the decoder. Property: a message is rejected
+// with a reason, or everything it hands to the filter is finite with a
+// unit-norm orientation and a known frame: no NaN ever reaches the estimate
+// through here. A fix goes on as sent (the navsat transform judges it), so
+// it is put through a NavsatTransform: refused with a reason, or a finite
+// position and a covariance with a positive diagonal.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 
+#include "estimation/navsat_transform.hpp"
 #include "estimation/sensor_sample.hpp"
 #include "fuzz_check.hpp"
 #include "geometry/frame_tree.hpp"
@@ -52,7 +56,34 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
   static rtfuse::transport::SampleDecoder decoder(frames());
   const int n = static_cast<int>(size - 1);
   const std::uint8_t* msg = data + 1;
-  const std::uint8_t which = data[0] % 5;
+  const std::uint8_t which = data[0] % 6;
+  if (which == 5) {
+    SensorSample s;
+    if (decoder.decode(SensorKind::kNavSatFix, msg, n, &s) != DecodeResult::kOk) return 0;
+    FUZZ_CHECK(s.kind == SensorKind::kNavSatFix, "the kind asked for");
+    FUZZ_CHECK(s.frame >= -1 && s.frame < frames().size(), "a known frame or none");
+    // Fresh each input (no state carried between inputs): the fix as the
+    // datum, and the fix against a configured datum far from it.
+    rtfuse::est::NavsatTransform first_fix;
+    first_fix.set_heading(Eigen::Quaterniond::Identity());
+    rtfuse::est::NavsatParams p;
+    p.manual_datum = true;
+    p.datum = {47.3977, 8.5456, 0.0};
+    rtfuse::est::NavsatTransform configured(p);
+    for (rtfuse::est::NavsatTransform* t : {&first_fix, &configured}) {
+      rtfuse::est::PoseSample pose;
+      const auto r = t->convert(s.stamp, s.navsat, rtfuse::geometry::RigidTransform{}, &pose);
+      FUZZ_CHECK(rtfuse::est::to_string(r) != nullptr, "every refusal has a name");
+      if (r != rtfuse::est::NavsatRejection::kNone) continue;
+      FUZZ_CHECK(finite(pose.position) && finite(pose.covariance), "an accepted fix is finite");
+      for (int i = 0; i < 3; ++i) FUZZ_CHECK(pose.covariance(i, i) > 0.0, "a positive variance");
+      const rtfuse::est::NavSatFixSample back = t->filtered_fix(pose.position, pose.covariance.topLeftCorner<3, 3>());
+      const rtfuse::est::GeodeticPosition& g = back.position;
+      FUZZ_CHECK(std::isfinite(g.altitude_m) && std::fabs(g.latitude_deg) <= 90.0 && std::fabs(g.longitude_deg) <= 180.0,
+                 "the filtered fix is a position on the earth");
+    }
+    return 0;
+  }
   if (which == 4) {
     rtfuse::est::PoseSample pose;
     rtfuse::TimeNs stamp = 0;
@@ -83,6 +114,7 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     case SensorKind::kTwist:
       check_twist(s.twist);
       break;
+    case SensorKind::kNavSatFix: break;  // not selected here (which == 5 above)
     case SensorKind::kImu:
       if (s.imu.has_orientation) {
         FUZZ_CHECK(finite(s.imu.orientation.coeffs()) && finite(s.imu.orientation_covariance), "imu orientation");

@@ -454,7 +454,7 @@ TEST(ConfigLoader, SensorTypeLimitsItsConfig) {
   EXPECT_EQ(single_error(load(sensor("imu0", "imu", "c", "", none))),
             "test.toml:5:1: sensor[0].config: fuses nothing: at least one entry must be true");
   EXPECT_EQ(single_error(load(sensor("g", "gps", "c"))),
-            "test.toml:3:8: sensor[0].type: must be one of odometry, pose, twist, imu, got 'gps'");
+            "test.toml:3:8: sensor[0].type: must be one of odometry, pose, twist, imu, navsat, got 'gps'");
   EXPECT_EQ(single_error(load(sensor("o", "odometry", "c",
                                      "remove_gravitational_acceleration = true\n",
                                      "config = [true, true, false, false, false, false, false, false, false, "

@@ -382,3 +382,47 @@ TEST(EncodeBuffer, RefusesWhatDoesNotFit) {
 
 }  // namespace
 }  // namespace rtfuse::transport
+
+namespace rtfuse::transport {
+namespace {
+
+TEST_F(SampleDecoderTest, NavSatFixKeepsItsValuesForTheNavsatTransformToJudge) {
+  rtfuse::navsat_fix_t m{};
+  m.header.utime = 1'234'567;
+  m.header.frame_id = "base_link";
+  m.status = rtfuse::navsat_fix_t::STATUS_SBAS_FIX;
+  m.latitude = 47.3977;
+  m.longitude = 8.5456;
+  m.altitude = 488.25;
+  for (int i = 0; i < 9; ++i) m.position_covariance[i] = 0.1 * (i + 1);  // row major, east north up
+  m.position_covariance_type = rtfuse::navsat_fix_t::COVARIANCE_TYPE_KNOWN;
+  out_.sensor = 3;
+  ASSERT_EQ(decode(SensorKind::kNavSatFix, m), DecodeResult::kOk);
+  EXPECT_EQ(out_.sensor, 3);
+  EXPECT_EQ(out_.kind, SensorKind::kNavSatFix);
+  EXPECT_EQ(out_.stamp, 1'234'567'000);
+  EXPECT_EQ(out_.frame, base_);
+  EXPECT_EQ(out_.navsat.status, 1);
+  EXPECT_EQ(out_.navsat.covariance_type, 3);
+  EXPECT_EQ(out_.navsat.position.latitude_deg, 47.3977);
+  EXPECT_EQ(out_.navsat.position.longitude_deg, 8.5456);
+  EXPECT_EQ(out_.navsat.position.altitude_m, 488.25);
+  EXPECT_DOUBLE_EQ(out_.navsat.covariance(0, 1), 0.2);
+  EXPECT_DOUBLE_EQ(out_.navsat.covariance(1, 0), 0.4);
+
+  // A NaN latitude, no fix, an unknown frame: passed on (the transform
+  // counts them by reason), not lost as a decode error.
+  m.latitude = NAN;
+  m.status = rtfuse::navsat_fix_t::STATUS_NO_FIX;
+  m.header.frame_id = "gps_antenna";
+  ASSERT_EQ(decode(SensorKind::kNavSatFix, m), DecodeResult::kOk);
+  EXPECT_TRUE(std::isnan(out_.navsat.position.latitude_deg));
+  EXPECT_EQ(out_.navsat.status, -1);
+  EXPECT_EQ(out_.frame, -1);
+
+  // Another type's bytes on a navsat channel.
+  EXPECT_EQ(decode(SensorKind::kNavSatFix, good_odometry()), DecodeResult::kWrongType);
+}
+
+}  // namespace
+}  // namespace rtfuse::transport
