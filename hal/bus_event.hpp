@@ -32,6 +32,7 @@ enum class BusEventKind : std::uint8_t {
   kClockSleepUntil,
   kSerialRead,
   kSerialWrite,
+  kSerialReopen,
 };
 
 // The call's name as divergence reports and logs spell it.
@@ -48,6 +49,7 @@ inline const char* to_string(BusEventKind k) noexcept {
     case BusEventKind::kClockSleepUntil: return "clock_sleep_until";
     case BusEventKind::kSerialRead: return "serial_read";
     case BusEventKind::kSerialWrite: return "serial_write";
+    case BusEventKind::kSerialReopen: return "serial_reopen";
   }
   return "unknown";
 }

@@ -45,4 +45,14 @@ HalStatus RecordingSerialPort::write(const std::uint8_t* data, int size) noexcep
   return result;
 }
 
+bool RecordingSerialPort::reopen() noexcept {
+  BusEvent ev;
+  ev.kind = BusEventKind::kSerialReopen;
+  ev.time_ns = clock_ != nullptr ? clock_->now() : 0;
+  const bool back = inner_.reopen();
+  ev.status = back ? HalStatus::kOk : HalStatus::kClosed;
+  tap_.push(ev);
+  return back;
+}
+
 }  // namespace rtfuse::hal

@@ -23,6 +23,7 @@ class RecordingSerialPort final : public SerialPort {
   int read(std::uint8_t* out, int max, TimeNs timeout_ns, TimeNs* stamp, HalStatus* status) noexcept override;
   HalStatus write(const std::uint8_t* data, int size) noexcept override;
   const char* last_error() const noexcept override { return inner_.last_error(); }
+  bool reopen() noexcept override;
 
   std::int64_t overflows() const noexcept { return tap_.overflows(); }
   std::uint8_t device() const noexcept { return tap_.device(); }

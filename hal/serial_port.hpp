@@ -22,6 +22,10 @@ class SerialPort {
   virtual HalStatus write(const std::uint8_t* data, int size) noexcept = 0;
   // errno text of the last failure (never allocates to read).
   virtual const char* last_error() const noexcept = 0;
+  // After kClosed (the device went away): open it again. True when it is
+  // back; false leaves it closed with last_error() saying why. May allocate
+  // (a re-initialisation after a device loss is outside the RT rules).
+  virtual bool reopen() noexcept = 0;
 };
 
 }  // namespace rtfuse::hal

@@ -75,7 +75,11 @@ int GnssReceiver::poll(TimeNs timeout_ns, GnssFix* out, int max) noexcept {
   }
   if (status == hal::HalStatus::kClosed) {
     health_ = GnssHealth::kClosed;
-  } else if (status != hal::HalStatus::kTimeout && status != hal::HalStatus::kWouldBlock) {
+    return 0;
+  }
+  // The port answers again (reopened): the receiver has yet to speak.
+  if (health_ == GnssHealth::kClosed) health_ = GnssHealth::kStarting;
+  if (status != hal::HalStatus::kTimeout && status != hal::HalStatus::kWouldBlock) {
     ++stats_.read_errors;
   }
   const TimeNs since = last_byte_ >= 0 ? last_byte_ : started_;

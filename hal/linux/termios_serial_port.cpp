@@ -63,6 +63,11 @@ bool gone(int err) noexcept { return err == EIO || err == ENXIO || err == ENODEV
 
 }  // namespace
 
+bool TermiosSerialPort::supports(int baud) noexcept {
+  speed_t unused;
+  return speed_for(baud, &unused);
+}
+
 std::string TermiosSerialPort::supported_bauds() {
   std::string s;
   for (const Rate& r : kRates) {

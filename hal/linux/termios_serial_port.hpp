@@ -50,6 +50,7 @@ class TermiosSerialPort final : public SerialPort {
 
   // "4800, 9600, ..., 921600": the rates open() accepts.
   static std::string supported_bauds();
+  static bool supports(int baud) noexcept;
   // The start-up message for `call` failing with `err` on `path`. Exposed so
   // tests can check the advice for errors a root test run cannot produce.
   static std::string describe_open_failure(const std::string& path, const char* call, int err);
@@ -69,7 +70,7 @@ class TermiosSerialPort final : public SerialPort {
   // Opens the same path with the same settings again (after kClosed, or to
   // reset a port something else reconfigured). Allocates: it runs after the
   // device went away, never on a healthy data path. False with last_error().
-  bool reopen() noexcept;
+  bool reopen() noexcept override;
 
   bool closed() const noexcept { return fd_ < 0; }
   const std::string& path() const noexcept { return path_; }

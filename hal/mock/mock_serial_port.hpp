@@ -60,6 +60,8 @@ class MockSerialPort final : public SerialPort {
   int read(std::uint8_t* out, int max, TimeNs timeout_ns, TimeNs* stamp, HalStatus* status) noexcept override;
   HalStatus write(const std::uint8_t* data, int size) noexcept override;
   const char* last_error() const noexcept override { return last_error_; }
+  // Back once replugged, as a tty node reappears.
+  bool reopen() noexcept override { return !unplugged_; }
 
  private:
   // Copies out the bytes due by now; 0 if none.

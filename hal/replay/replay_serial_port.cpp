@@ -42,6 +42,15 @@ HalStatus ReplaySerialPort::write(const std::uint8_t* data, int size) noexcept {
   return HalStatus::kOk;
 }
 
+bool ReplaySerialPort::reopen() noexcept {
+  BusEvent call;
+  call.kind = BusEventKind::kSerialReopen;
+  call.device = device_;
+  const BusEvent* rec = stream_.take(call);
+  last_status_ = rec == nullptr ? HalStatus::kClosed : rec->status;
+  return last_status_ == HalStatus::kOk;
+}
+
 const char* ReplaySerialPort::last_error() const noexcept {
   return stream_.diverged() ? stream_.divergence() : to_string(last_status_);
 }

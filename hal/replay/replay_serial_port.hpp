@@ -18,6 +18,7 @@ class ReplaySerialPort final : public SerialPort {
   int read(std::uint8_t* out, int max, TimeNs timeout_ns, TimeNs* stamp, HalStatus* status) noexcept override;
   HalStatus write(const std::uint8_t* data, int size) noexcept override;
   const char* last_error() const noexcept override;
+  bool reopen() noexcept override;
 
   std::uint8_t device() const noexcept { return device_; }
 

@@ -55,6 +55,7 @@ bool same_call(const BusEvent& rec, const BusEvent& call) {
     case BusEventKind::kSerialWrite:
       return rec.length == call.length &&
              std::memcmp(rec.data, call.data, static_cast<std::size_t>(stored_bytes(rec))) == 0;
+    case BusEventKind::kSerialReopen: return true;
     case BusEventKind::kNone: return true;
   }
   return false;
@@ -186,6 +187,7 @@ int ReplayStream::describe(char* buf, std::size_t size, const BusEvent& ev, bool
       break;
     }
     case BusEventKind::kClockNow:
+    case BusEventKind::kSerialReopen:
     case BusEventKind::kNone: break;
   }
   return t.length();

@@ -22,7 +22,7 @@ using Name = FixedString<63>;
 
 // Where a sensor's samples come from: decoded LCM messages, or one of the
 // drivers this process runs.
-enum class SensorSource : std::uint8_t { kLcm, kWheelOdometry, kMpu, kStereoVo };
+enum class SensorSource : std::uint8_t { kLcm, kWheelOdometry, kMpu, kStereoVo, kGnss };
 
 struct SensorConfig {
   Name name;        // "odom0", "imu0", ... (robot_localization's sensor names)

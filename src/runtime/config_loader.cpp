@@ -324,8 +324,10 @@ SensorEntry read_sensor(const Section& s) {
       e.cfg.source = SensorSource::kMpu;
     } else if (source == "stereo_vo") {
       e.cfg.source = SensorSource::kStereoVo;
+    } else if (source == "gnss") {
+      e.cfg.source = SensorSource::kGnss;
     } else {
-      s.value_error("source", "must be one of lcm, wheel_odometry, mpu, stereo_vo, got " + in_quotes(source));
+      s.value_error("source", "must be one of lcm, wheel_odometry, mpu, stereo_vo, gnss, got " + in_quotes(source));
     }
   }
   // A driver-fed sensor has no channel; an LCM one needs it.
@@ -531,7 +533,7 @@ void read_sim(const Section& s, LcmSimConfig& sim) {
 
 void read_root(const Section& root, RuntimeConfig& cfg) {
   root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "static_transform", "sim", "hardware",
-                       "can", "wheel_odometry", "mpu", "camera", "vo"});
+                       "can", "wheel_odometry", "mpu", "camera", "vo", "gnss"});
   Diagnostics& d = root.diag();
   read_filter(Section(section_table(root, "filter"), "filter", d), cfg);
   read_realtime(Section(section_table(root, "realtime"), "realtime", d), cfg.realtime);

@@ -37,6 +37,13 @@ const char* const kVoKeys[] = {"pairs",      "motions",      "fps_milli",   "ski
                                "residual_milli_px", "time_us", "max_time_us", "latency_us"};
 const int kVoKeyCount = sizeof(kVoKeys) / sizeof(kVoKeys[0]);
 static_assert(sizeof(kVoKeys) / sizeof(kVoKeys[0]) <= kMaxDeviceValues, "more VO keys than a device holds");
+// The receiver's epochs and faults (drivers::GnssReceiverStats); hdop_milli
+// the last epoch's HDOP x1000 (-1 unknown).
+const char* const kGnssKeys[] = {"epochs",      "fixes",      "no_fix",        "two_d",      "dead_reckoning",
+                                 "time_jumps",  "refused",    "lost_epochs",   "bytes",      "read_errors",
+                                 "silent_events", "reopens",  "satellites",    "hdop_milli"};
+const int kGnssKeyCount = sizeof(kGnssKeys) / sizeof(kGnssKeys[0]);
+static_assert(sizeof(kGnssKeys) / sizeof(kGnssKeys[0]) <= kMaxDeviceValues, "more GNSS keys than a device holds");
 // The navsat transform's refusals by reason (est::NavsatStats).
 const char* const kNavsatKeys[] = {"accepted", "no_fix",        "invalid_position", "invalid_covariance",
                                    "waiting_for_heading", "jumps", "reanchors"};
@@ -62,6 +69,7 @@ DeviceSlots device_slots(const RuntimeConfig& cfg) noexcept {
   if (hw.mpu.enabled) s.imu = s.count++;
   if (hw.camera.enabled) s.camera = s.count++;
   if (hw.camera.enabled && hw.vo.enabled && hw.vo_sensor >= 0) s.vo = s.count++;
+  if (hw.gnss.enabled) s.gnss = s.count++;
   for (int i = 0; i < cfg.num_sensors; ++i) {
     if (cfg.sensors[static_cast<std::size_t>(i)].params.kind != est::SensorKind::kNavSatFix) continue;
     if (s.num_navsat == kMaxNavsatSensors) break;  // the loader refuses more
@@ -129,6 +137,14 @@ int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexc
     std::snprintf(buf, sizeof buf, "%s %s", hw.camera.device.c_str(), hw.camera.frame.c_str());
     d.hardware_id = buf;
     keys(d, kVoKeys, kVoKeyCount);
+  }
+  if (slots.gnss >= 0) {
+    DeviceStatus& d = out[slots.gnss];
+    d.name = "gnss";
+    std::snprintf(buf, sizeof buf, "%s %s@%d", hw.gnss.device.c_str(),
+                  hw.gnss.protocol == GnssProtocolConfig::kUbx ? "ubx" : "nmea", hw.gnss.baud);
+    d.hardware_id = buf;
+    keys(d, kGnssKeys, kGnssKeyCount);
   }
   int k = 0;
   for (int i = 0; i < cfg.num_sensors && k < slots.num_navsat; ++i) {

@@ -11,7 +11,8 @@ namespace rtfuse {
 
 // Slot order: CAN bus, then one per encoder node in [[can.node]] order, then
 // wheel odometry, then the IMU, then the camera, then its visual odometry,
-// then one navsat transform per navsat sensor in [[sensor]] order.
+// then the GNSS receiver, then one navsat transform per navsat sensor in
+// [[sensor]] order.
 struct DeviceSlots {
   int can_bus = -1;
   int first_node = -1;
@@ -19,6 +20,7 @@ struct DeviceSlots {
   int imu = -1;
   int camera = -1;
   int vo = -1;
+  int gnss = -1;
   int first_navsat = -1;
   int num_navsat = 0;
   int count = 0;
@@ -42,6 +44,8 @@ extern const char* const kCameraKeys[];
 extern const int kCameraKeyCount;
 extern const char* const kVoKeys[];
 extern const int kVoKeyCount;
+extern const char* const kGnssKeys[];
+extern const int kGnssKeyCount;
 extern const char* const kNavsatKeys[];
 extern const int kNavsatKeyCount;
 

@@ -8,6 +8,7 @@
 #include "hal/clock.hpp"
 #include "hal/gpio.hpp"
 #include "hal/i2c_bus.hpp"
+#include "hal/serial_port.hpp"
 #include "hal/video_stream.hpp"
 
 namespace rtfuse {
@@ -27,10 +28,18 @@ struct CameraBuses {
   hal::Clock* clock = nullptr;
 };
 
+// The GNSS thread's: the receiver's serial port, and the clock it measures
+// silence and reopen backoffs on.
+struct GnssBuses {
+  hal::SerialPort* serial = nullptr;
+  hal::Clock* clock = nullptr;
+};
+
 struct HalBuses {
   hal::CanBus* can = nullptr;  // the wheel encoders' bus, polled by the loop thread
   ImuBuses imu;
   CameraBuses camera;
+  GnssBuses gnss;
 };
 
 }  // namespace rtfuse

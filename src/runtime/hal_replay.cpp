@@ -10,6 +10,7 @@
 #include "hal/replay/replay_clock.hpp"
 #include "hal/replay/replay_gpio.hpp"
 #include "hal/replay/replay_i2c_bus.hpp"
+#include "hal/replay/replay_serial_port.hpp"
 #include "hal/replay/replay_video_stream.hpp"
 #include "runtime/camera_calibration.hpp"
 #include "runtime/recording_tap.hpp"
@@ -158,6 +159,9 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   std::unique_ptr<hal::GpioEdgeSource> drdy;
   std::unique_ptr<hal::Clock> clock;
   const int camera = stream_index(rec.info, kCameraStream);
+  const int gnss = stream_index(rec.info, kGnssStream);
+  std::unique_ptr<hal::SerialPort> serial;
+  std::unique_ptr<hal::Clock> gnss_clock;
   std::unique_ptr<hal::VideoStream> video;
   FreeRunningClock camera_clock;
   HalBuses buses;
@@ -188,12 +192,18 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
         if (dev.stream == imu && !clock) {
           clock = std::make_unique<hal::replay::ReplayClock>(stream, index);
           buses.imu.clock = clock.get();
+        } else if (dev.stream == gnss && !gnss_clock) {
+          gnss_clock = std::make_unique<hal::replay::ReplayClock>(stream, index);
+          buses.gnss.clock = gnss_clock.get();
         }
         break;
       case transport::DeviceKind::kGpioOutput: break;
-      // No device of this build reads a serial port yet: its calls stay
-      // unreplayed, and the loop's recorded intake says whether that matters.
-      case transport::DeviceKind::kSerial: break;
+      case transport::DeviceKind::kSerial:
+        if (dev.stream == gnss && !serial) {
+          serial = std::make_unique<hal::replay::ReplaySerialPort>(stream, index);
+          buses.gnss.serial = serial.get();
+        }
+        break;
       case transport::DeviceKind::kVideo:
         if (dev.stream == camera && !video && static_cast<std::size_t>(dev.stream) < rec.videos.size() &&
             rec.videos[static_cast<std::size_t>(dev.stream)]) {
@@ -216,6 +226,10 @@ HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const R
   }
   if (hw.camera.enabled && buses.camera.video == nullptr) {
     result.error = "the configuration has [camera] but the recording has no camera stream";
+    return result;
+  }
+  if (hw.gnss.enabled && (buses.gnss.serial == nullptr || buses.gnss.clock == nullptr)) {
+    result.error = "the configuration has [gnss] but the recording has no serial port and clock of the GNSS thread";
     return result;
   }
   for (int i = 0; i < cfg.num_sensors; ++i) {

@@ -28,6 +28,11 @@ std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& co
     if (!h->camera_) return nullptr;
     h->threaded_[h->num_threaded_++] = h->camera_.get();
   }
+  if (hw.gnss.enabled) {
+    h->gnss_ = GnssDevice::create(buses.gnss, core, h->slots_.gnss, error);
+    if (!h->gnss_) return nullptr;
+    h->threaded_[h->num_threaded_++] = h->gnss_.get();
+  }
   return h;
 }
 

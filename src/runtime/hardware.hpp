@@ -14,6 +14,7 @@
 #include "runtime/camera_device.hpp"
 #include "runtime/device_layout.hpp"
 #include "runtime/fusion_core.hpp"
+#include "runtime/gnss_device.hpp"
 #include "runtime/hal_buses.hpp"
 #include "runtime/imu_device.hpp"
 #include "runtime/thread_device.hpp"
@@ -42,6 +43,7 @@ class Hardware final : public TickDevices {
 
   ImuDevice* imu() { return imu_.get(); }
   CameraDevice* camera() { return camera_.get(); }
+  GnssDevice* gnss() { return gnss_.get(); }
   const drivers::CanopenEncoders* encoders() const { return wheels_ ? &wheels_->encoders() : nullptr; }
   const drivers::WheelOdometry* wheel_odometry() const { return wheels_ ? wheels_->wheel_odometry() : nullptr; }
 
@@ -53,6 +55,7 @@ class Hardware final : public TickDevices {
   std::unique_ptr<WheelEncoderDevice> wheels_;
   std::unique_ptr<ImuDevice> imu_;
   std::unique_ptr<CameraDevice> camera_;
+  std::unique_ptr<GnssDevice> gnss_;
   ThreadDevice* threaded_[kMaxThreadDevices] = {};
   int num_threaded_ = 0;
 };

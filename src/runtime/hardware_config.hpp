@@ -21,6 +21,7 @@ enum class WheelSideConfig : std::uint8_t { kLeft, kRight };
 enum class KinematicsConfig : std::uint8_t { kDifferential, kSkidSteer };
 enum class MpuModelConfig : std::uint8_t { kAuto, kMpu6050, kMpu6500, kMpu9250 };
 enum class AttitudeAlgorithmConfig : std::uint8_t { kMadgwick, kMahony };
+enum class GnssProtocolConfig : std::uint8_t { kUbx, kNmea };
 
 constexpr int kMaxWheelNodes = 8;
 
@@ -137,6 +138,24 @@ struct VoSection {
   double min_angular_sigma_rad_s = 0.002;
 };
 
+// [gnss]: a GNSS receiver on a serial port (UART or USB CDC-ACM), feeding
+// the [[sensor]] with source = "gnss" (a navsat sensor) its fixes.
+struct GnssSection {
+  bool enabled = false;
+  HwName device{"/dev/ttyACM0"};
+  int baud = 115200;  // a USB CDC-ACM port ignores it; a UART needs the receiver's
+  GnssProtocolConfig protocol = GnssProtocolConfig::kUbx;
+  bool use_rmc = true;   // NMEA: wait for RMC in each epoch
+  bool use_gst = false;  // NMEA: wait for GST (the receiver's error estimate)
+  // The receiver sends an epoch this long after it (u-blox: 50-200 ms, the
+  // more the higher the rate and the longer the messages): the fix is fused
+  // at its epoch, through the filter's lagged-data history.
+  double latency_s = 0.1;
+  double silent_after_s = 2.0;  // no byte for this long: the receiver is silent
+  double reopen_backoff_s = 0.5;  // first wait before reopening an unplugged receiver
+  double reopen_backoff_max_s = 8.0;
+};
+
 struct HardwareConfig {
   HalBackend backend = HalBackend::kNone;
   std::string scenario;  // backend "sim": the drive scenario file (resolved path)
@@ -145,9 +164,11 @@ struct HardwareConfig {
   MpuSection mpu;
   CameraSection camera;
   VoSection vo;
+  GnssSection gnss;
   int wheel_sensor = -1;  // index of the [[sensor]] with source = "wheel_odometry"
   int mpu_sensor = -1;    // index of the [[sensor]] with source = "mpu"
   int vo_sensor = -1;     // index of the [[sensor]] with source = "stereo_vo"
+  int gnss_sensor = -1;   // index of the [[sensor]] with source = "gnss"
 };
 
 }  // namespace rtfuse

@@ -5,6 +5,7 @@
 #include <string_view>
 
 #include "drivers/camera/camera_modes.hpp"
+#include "hal/linux/termios_serial_port.hpp"
 #include "hal/video_stream.hpp"
 
 namespace rtfuse::config {
@@ -351,6 +352,43 @@ void read_vo(const Section& s, VoSection& v) {
               "must be >= 0 rad/s and finite");
 }
 
+void read_gnss(const Section& s, GnssSection& g) {
+  s.reject_unknown({"device", "baud", "protocol", "use_rmc", "use_gst", "latency", "silent_after", "reopen_backoff",
+                    "reopen_backoff_max"});
+  g.enabled = true;
+  s.read_name("device", g.device);
+  read_int(s, "baud", g.baud, 1, 4'000'000);
+  if (!hal::TermiosSerialPort::supports(g.baud)) {
+    s.value_error("baud", "must be one of " + hal::TermiosSerialPort::supported_bauds() + ", got " +
+                              std::to_string(g.baud));
+  }
+  std::string protocol;
+  if (s.read("protocol", protocol)) {
+    if (protocol == "ubx") {
+      g.protocol = GnssProtocolConfig::kUbx;
+    } else if (protocol == "nmea") {
+      g.protocol = GnssProtocolConfig::kNmea;
+    } else {
+      s.value_error("protocol", "must be ubx (u-blox NAV-PVT) or nmea (GGA/RMC/GST), got " + in_quotes(protocol));
+    }
+  }
+  s.read("use_rmc", g.use_rmc);
+  s.read("use_gst", g.use_gst);
+  if (g.protocol == GnssProtocolConfig::kUbx) {
+    for (std::string_view k : {"use_rmc", "use_gst"}) {
+      if (s.has(k)) s.key_error(k, "only valid with protocol = \"nmea\"");
+    }
+  }
+  read_number(s, "latency", g.latency_s, [](double v) { return v >= 0 && v <= 2.0; }, "must be >= 0 and <= 2 s");
+  read_number(s, "silent_after", g.silent_after_s, [](double v) { return v >= 0.2 && v <= 60.0; },
+              "must be >= 0.2 and <= 60 s");
+  read_number(s, "reopen_backoff", g.reopen_backoff_s, positive_finite, "must be > 0 s and finite");
+  read_number(s, "reopen_backoff_max", g.reopen_backoff_max_s, positive_finite, "must be > 0 s and finite");
+  if (g.reopen_backoff_max_s < g.reopen_backoff_s) {
+    s.value_error("reopen_backoff_max", "must be >= reopen_backoff");
+  }
+}
+
 }  // namespace
 
 void read_hardware(const Section& root, RuntimeConfig& cfg) {
@@ -373,9 +411,11 @@ void read_hardware(const Section& root, RuntimeConfig& cfg) {
     read_vo(Section(vo, "vo", d), hw.vo);
     if (!camera) Section(vo, "vo", d).table_error("vo", "needs a [camera] section: the odometry runs on its frames");
   }
-  if ((can || mpu || camera) && hw.backend == HalBackend::kNone) {
-    const char* name = can ? "can" : (mpu ? "mpu" : "camera");
-    const Section s(can ? can : (mpu ? mpu : camera), name, d);
+  const toml::table* gnss = section_table(root, "gnss");
+  if (gnss) read_gnss(Section(gnss, "gnss", d), hw.gnss);
+  if ((can || mpu || camera || gnss) && hw.backend == HalBackend::kNone) {
+    const char* name = can ? "can" : (mpu ? "mpu" : (camera ? "camera" : "gnss"));
+    const Section s(can ? can : (mpu ? mpu : (camera ? camera : gnss)), name, d);
     s.table_error("hardware.backend", std::string("[") + name +
                                           "] needs hardware.backend = \"linux\" (real devices) or \"sim\"");
   }
@@ -384,6 +424,8 @@ void read_hardware(const Section& root, RuntimeConfig& cfg) {
   hw.mpu_sensor = find_source(root, cfg, SensorSource::kMpu, "mpu", est::SensorKind::kImu, "imu", mpu != nullptr, "mpu");
   hw.vo_sensor = find_source(root, cfg, SensorSource::kStereoVo, "stereo_vo", est::SensorKind::kTwist, "twist",
                              vo != nullptr, "vo");
+  hw.gnss_sensor = find_source(root, cfg, SensorSource::kGnss, "gnss", est::SensorKind::kNavSatFix, "navsat",
+                               gnss != nullptr, "gnss");
 }
 
 }  // namespace rtfuse::config

@@ -6,6 +6,7 @@
 #include "hal/linux/i2c_dev_bus.hpp"
 #include "hal/linux/monotonic_clock.hpp"
 #include "hal/linux/socketcan_bus.hpp"
+#include "hal/linux/termios_serial_port.hpp"
 #include "hal/linux/v4l2_stream.hpp"
 
 namespace rtfuse {
@@ -15,6 +16,7 @@ struct LinuxHal::Devices {
   std::unique_ptr<hal::I2cDevBus> i2c;
   std::unique_ptr<hal::GpiodEdgeSource> drdy;
   std::unique_ptr<hal::V4l2Stream> video;
+  std::unique_ptr<hal::TermiosSerialPort> gnss;
   hal::MonotonicClock clock;
 };
 
@@ -79,6 +81,12 @@ std::unique_ptr<LinuxHal> LinuxHal::open(const RuntimeConfig& cfg, std::string* 
     h->buses_.camera.video = d.video.get();
     h->buses_.camera.clock = &d.clock;
   }
+  if (hw.gnss.enabled) {
+    d.gnss = hal::TermiosSerialPort::open(hw.gnss.device.c_str(), hw.gnss.baud, error);
+    if (!d.gnss) return nullptr;
+    h->buses_.gnss.serial = d.gnss.get();
+    h->buses_.gnss.clock = &d.clock;
+  }
   return h;
 }
 
@@ -90,6 +98,10 @@ std::string LinuxHal::describe() const {
   if (d.drdy) out += "IMU data-ready: GPIO rising edges, kernel-stamped\n";
   if (d.i2c && !d.drdy) out += "IMU data-ready: none, polled at the sample rate\n";
   if (d.video) out += "camera: V4L2 mmap streaming\n";
+  if (d.gnss) {
+    out += "GNSS receiver " + d.gnss->path() + ": termios raw at " + std::to_string(d.gnss->baud()) +
+           " baud, stamped at read\n";
+  }
   return out;
 }
 

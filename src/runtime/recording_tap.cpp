@@ -24,6 +24,7 @@ std::string i2c_device_name(const RuntimeConfig& cfg) { return device_name(cfg.h
 std::string video_device_name(const RuntimeConfig& cfg) {
   return device_name(cfg.hardware.camera.device.view(), "video");
 }
+std::string gnss_device_name(const RuntimeConfig& cfg) { return device_name(cfg.hardware.gnss.device.view(), "gnss"); }
 
 RecordingTap::~RecordingTap() = default;
 
@@ -58,6 +59,13 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
     imu_clock = add("imu-clock", transport::DeviceKind::kClock, 1);
   }
   const int camera = inner.camera.video != nullptr ? add(video_device_name(cfg), transport::DeviceKind::kVideo, 2) : -1;
+  int gnss = -1, gnss_clock = -1, gnss_stream = -1;
+  if (inner.gnss.serial != nullptr && inner.gnss.clock != nullptr) {
+    gnss_stream = static_cast<int>(info.streams.size());
+    info.streams.push_back(kGnssStream);
+    gnss = add(gnss_device_name(cfg), transport::DeviceKind::kSerial, gnss_stream);
+    gnss_clock = add("gnss-clock", transport::DeviceKind::kClock, gnss_stream);
+  }
   runtime::RecorderRingSizes sizes;
   // A second of the loop at 1 kHz and of a 1 kHz IMU, so a writer stalled
   // by the disk for that long loses nothing.
@@ -96,6 +104,14 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
     b.camera.video = t->camera_.get();
     b.camera.clock = inner.camera.clock;
   }
+  if (gnss >= 0) {
+    t->gnss_ = std::make_unique<hal::RecordingSerialPort>(*inner.gnss.serial, r.ring(gnss_stream),
+                                                          static_cast<std::uint8_t>(gnss), &clock);
+    t->gnss_clock_ = std::make_unique<hal::RecordingClock>(*inner.gnss.clock, r.ring(gnss_stream),
+                                                           static_cast<std::uint8_t>(gnss_clock));
+    b.gnss.serial = t->gnss_.get();
+    b.gnss.clock = t->gnss_clock_.get();
+  }
   return t;
 }
 
@@ -106,6 +122,8 @@ std::int64_t RecordingTap::overflows() const {
   if (drdy_) n += drdy_->overflows();
   if (imu_clock_) n += imu_clock_->overflows();
   if (camera_) n += camera_->overflows();
+  if (gnss_) n += gnss_->overflows();
+  if (gnss_clock_) n += gnss_clock_->overflows();
   return n;
 }
 

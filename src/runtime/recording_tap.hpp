@@ -7,7 +7,9 @@
 //   stream "imu":  the I2C bus, the data-ready line, the IMU thread's clock;
 //   stream "camera": the camera's video stream (frames in a ring of their
 //   own; the camera thread's clock is not recorded: its driver reads it only
-//   to back off while the camera is unplugged).
+//   to back off while the camera is unplugged);
+//   stream "gnss": the receiver's serial port and the GNSS thread's clock
+//   (its silence and reopen backoff are decided on it).
 #include <memory>
 #include <string>
 
@@ -15,6 +17,7 @@
 #include "hal/recording_clock.hpp"
 #include "hal/recording_gpio.hpp"
 #include "hal/recording_i2c_bus.hpp"
+#include "hal/recording_serial_port.hpp"
 #include "hal/recording_video_stream.hpp"
 #include "runtime/config.hpp"
 #include "runtime/hal_buses.hpp"
@@ -27,6 +30,7 @@ namespace rtfuse {
 constexpr const char* kLoopStream = "loop";
 constexpr const char* kImuStream = "imu";
 constexpr const char* kCameraStream = "camera";
+constexpr const char* kGnssStream = "gnss";
 
 class RecordingTap {
  public:
@@ -52,6 +56,8 @@ class RecordingTap {
   std::unique_ptr<hal::RecordingEdgeSource> drdy_;
   std::unique_ptr<hal::RecordingClock> imu_clock_;
   std::unique_ptr<hal::RecordingVideoStream> camera_;
+  std::unique_ptr<hal::RecordingSerialPort> gnss_;
+  std::unique_ptr<hal::RecordingClock> gnss_clock_;
   HalBuses buses_;
 };
 
@@ -59,5 +65,6 @@ class RecordingTap {
 std::string can_device_name(const RuntimeConfig& cfg);
 std::string i2c_device_name(const RuntimeConfig& cfg);
 std::string video_device_name(const RuntimeConfig& cfg);
+std::string gnss_device_name(const RuntimeConfig& cfg);
 
 }  // namespace rtfuse

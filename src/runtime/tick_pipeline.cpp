@@ -29,7 +29,7 @@ std::unique_ptr<TickPipeline> TickPipeline::create(const RuntimeConfig& cfg, con
     buses = p->tap_->buses();
   }
   const HardwareConfig& hw = p->core_->config().hardware;
-  if (hw.can.enabled || hw.mpu.enabled || hw.camera.enabled) {
+  if (hw.can.enabled || hw.mpu.enabled || hw.camera.enabled || hw.gnss.enabled) {
     p->hardware_ = Hardware::create(buses, *p->core_, error);
     if (!p->hardware_) return nullptr;
     p->core_->set_devices(p->hardware_.get());

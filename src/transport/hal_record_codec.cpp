@@ -107,7 +107,9 @@ bool records(DeviceKind device, BusEventKind call) noexcept {
     case DeviceKind::kGpioOutput: return call == BusEventKind::kGpioSet;
     case DeviceKind::kClock: return call == BusEventKind::kClockNow || call == BusEventKind::kClockSleepUntil;
     case DeviceKind::kVideo: return false;  // hal_video_t, through HalRecordCodec::encode_video
-    case DeviceKind::kSerial: return call == BusEventKind::kSerialRead || call == BusEventKind::kSerialWrite;
+    case DeviceKind::kSerial:
+      return call == BusEventKind::kSerialRead || call == BusEventKind::kSerialWrite ||
+             call == BusEventKind::kSerialReopen;
   }
   return false;
 }
@@ -486,13 +488,15 @@ int HalRecordCodec::encode(const BusEvent& ev, std::uint8_t* buf, int capacity) 
       m.utime = utime;
       m.time_ns = ev.time_ns;
       m.device = dev.name;
-      m.call = read ? rtfuse::hal_serial_t::READ : rtfuse::hal_serial_t::WRITE;
+      m.call = read ? rtfuse::hal_serial_t::READ
+                    : (ev.kind == BusEventKind::kSerialWrite ? rtfuse::hal_serial_t::WRITE : rtfuse::hal_serial_t::REOPEN);
       m.status = status;
       m.length = ev.length;
       m.timeout_ns = ev.timeout_ns;
       m.stamp_ns = ev.edge_stamp;
       m.lost_before = lost;
-      m.num_data = std::clamp<int>(read ? ev.count : ev.length, 0, hal::kBusEventMaxBytes);
+      m.num_data = std::clamp<int>(read ? ev.count : (ev.kind == BusEventKind::kSerialWrite ? ev.length : 0), 0,
+                                   hal::kBusEventMaxBytes);
       m.data.assign(ev.data, ev.data + m.num_data);
       return encode_into(m, buf, capacity);
     }
@@ -637,10 +641,14 @@ bool HalRecordCodec::decode(std::string_view channel, const void* data, int size
       }
       rtfuse::hal_serial_t& m = msgs_->serial;
       if (!decode_message(m, data, size, kType, error) || !check_common(m.device, m.status, kType)) return false;
-      if (m.call != rtfuse::hal_serial_t::READ && m.call != rtfuse::hal_serial_t::WRITE) {
+      if (m.call != rtfuse::hal_serial_t::READ && m.call != rtfuse::hal_serial_t::WRITE &&
+          m.call != rtfuse::hal_serial_t::REOPEN) {
         return bad_field(error, kType, "call", m.call);
       }
       const bool read = m.call == rtfuse::hal_serial_t::READ;
+      if (m.call == rtfuse::hal_serial_t::REOPEN && (m.length != 0 || m.num_data != 0)) {
+        return bad_field(error, kType, "length of a reopen", m.length != 0 ? m.length : m.num_data);
+      }
       if (m.length < 0 || m.length > hal::kBusEventMaxBytes) return bad_field(error, kType, "length", m.length);
       if (read ? m.num_data > m.length : m.num_data != m.length) {
         return bad_field(error, kType, "data byte count", m.num_data);
@@ -649,7 +657,8 @@ bool HalRecordCodec::decode(std::string_view channel, const void* data, int size
       // timeout to a read.
       if (m.stamp_ns != 0 && !(read && m.num_data > 0)) return bad_field(error, kType, "stamp_ns", m.stamp_ns);
       if (m.timeout_ns != 0 && !read) return bad_field(error, kType, "timeout_ns of a write", m.timeout_ns);
-      ev.kind = read ? BusEventKind::kSerialRead : BusEventKind::kSerialWrite;
+      ev.kind = read ? BusEventKind::kSerialRead
+                     : (m.call == rtfuse::hal_serial_t::WRITE ? BusEventKind::kSerialWrite : BusEventKind::kSerialReopen);
       ev.length = m.length;
       ev.timeout_ns = m.timeout_ns;
       ev.edge_stamp = m.stamp_ns;

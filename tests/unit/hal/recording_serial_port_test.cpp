@@ -112,6 +112,26 @@ TEST(HalRecordingSerialPort, AnUnpluggedPortIsRecordedAsClosed) {
   EXPECT_EQ(ev.length, 16);
 }
 
+TEST(HalRecordingSerialPort, ReopensAreRecordedAndReplayedWithTheirOutcome) {
+  Rig r;
+  r.port.unplug();
+  EXPECT_FALSE(r.rec.reopen());
+  r.port.replug();
+  EXPECT_TRUE(r.rec.reopen());
+  ReplayStream stream("gnss");
+  BusEvent ev;
+  std::int64_t n = 0;
+  while (r.ring.try_pop(ev)) {
+    EXPECT_EQ(ev.kind, BusEventKind::kSerialReopen);
+    stream.append(ev, ++n);
+  }
+  ASSERT_EQ(n, 2);
+  ReplaySerialPort port(stream, 3);
+  EXPECT_FALSE(port.reopen());
+  EXPECT_TRUE(port.reopen());
+  EXPECT_TRUE(stream.at_end());
+}
+
 // Records a session, loads it into a stream as rtfuse-replay would.
 struct Recorded {
   Recorded() {

@@ -171,6 +171,13 @@ std::vector<BusEvent> every_kind() {
   command.data[1] = 0x62;
   command.data[2] = 0x06;
   evs.push_back(command);
+
+  BusEvent reopen;
+  reopen.kind = BusEventKind::kSerialReopen;
+  reopen.device = 5;
+  reopen.time_ns = 6'000'000'000;
+  reopen.status = HalStatus::kClosed;
+  evs.push_back(reopen);
   return evs;
 }
 
