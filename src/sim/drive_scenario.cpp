@@ -367,10 +367,46 @@ void read_imu(const Section& s, SimImuConfig& imu) {
               "must be within the chip's -40..85 C");
 }
 
+void read_gnss(const Section& s, SimGnssConfig& g) {
+  s.reject_unknown({"rate_hz", "latitude_deg", "longitude_deg", "altitude_m", "latency_s", "bias_sigma_m",
+                    "vertical_bias_sigma_m", "bias_time_s", "noise_m", "vertical_noise_m", "multipath_per_hour",
+                    "multipath_m", "multipath_epochs", "satellites", "antenna_xyz_m", "outage"});
+  g.enabled = true;
+  read_number(s, "rate_hz", g.rate_hz, in_range(0.0, 20.0), "must be > 0 and <= 20 Hz");
+  read_number(s, "latitude_deg", g.latitude_deg, [](double v) { return v >= -84.0 && v <= 84.0; },
+              "must be within -84..84 degrees");
+  read_number(s, "longitude_deg", g.longitude_deg, [](double v) { return v >= -180.0 && v <= 180.0; },
+              "must be within -180..180 degrees");
+  read_number(s, "altitude_m", g.altitude_m, [](double v) { return v >= -500.0 && v <= 9000.0; },
+              "must be within -500..9000 m");
+  read_number(s, "latency_s", g.latency_s, [](double v) { return v >= 0.0 && v <= 1.0; }, "must be 0..1 s");
+  const auto metres = [](double v) { return v >= 0.0 && v <= 100.0; };
+  read_number(s, "bias_sigma_m", g.bias_sigma_m, metres, "must be 0..100 m");
+  read_number(s, "vertical_bias_sigma_m", g.vertical_bias_sigma_m, metres, "must be 0..100 m");
+  read_number(s, "bias_time_s", g.bias_time_s, in_range(0.0, 86400.0), "must be > 0 and <= 86400 s");
+  read_number(s, "noise_m", g.noise_m, metres, "must be 0..100 m");
+  read_number(s, "vertical_noise_m", g.vertical_noise_m, metres, "must be 0..100 m");
+  read_number(s, "multipath_per_hour", g.multipath_per_hour, [](double v) { return v >= 0.0 && v <= 3600.0; },
+              "must be 0..3600");
+  read_number(s, "multipath_m", g.multipath_m, metres, "must be 0..100 m");
+  read_int(s, "multipath_epochs", g.multipath_epochs, 1, 100);
+  read_int(s, "satellites", g.satellites, 0, 64);
+  read_triple(s, "antenna_xyz_m", 1.0, g.antenna_xyz_m);
+  config::for_each_table(s, "outage", kMaxGnssOutages, [&](const Section& e, bool fits) {
+    e.reject_unknown({"start_s", "duration_s"});
+    e.require({"start_s", "duration_s"});
+    GnssOutage o;
+    read_number(e, "start_s", o.start_s, [](double v) { return v >= 0.0 && v <= 86400.0; },
+                "must be >= 0 and <= 86400 s");
+    read_number(e, "duration_s", o.duration_s, in_range(0.0, 86400.0), "must be > 0 and <= 86400 s");
+    if (fits) g.outages[static_cast<std::size_t>(g.outage_count++)] = o;
+  });
+}
+
 // --- root -------------------------------------------------------------------
 
 void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_region>& path_where) {
-  root.reject_unknown({"duration_s", "seed", "limits", "path", "robot", "slip", "dropout", "imu"});
+  root.reject_unknown({"duration_s", "seed", "limits", "path", "robot", "slip", "dropout", "imu", "gnss"});
   Diagnostics& d = root.diag();
   read_number(root, "duration_s", sc.duration_s, in_range(0.0, 86400.0),
               "must be > 0 and <= 86400 s (leave it out to run as long as the path takes)");
@@ -399,6 +435,7 @@ void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_
   read_slip(root, sc.slip, sc.robot);
   read_dropouts(root, sc);
   read_imu(Section(config::section_table(root, "imu"), "imu", d), sc.imu);
+  if (const toml::table* gnss = config::section_table(root, "gnss")) read_gnss(Section(gnss, "gnss", d), sc.gnss);
 }
 
 }  // namespace

@@ -20,6 +20,7 @@ namespace rtfuse::sim {
 constexpr int kMaxSimWheels = 4;
 constexpr int kMaxSlipEpisodes = 16;
 constexpr int kMaxDropouts = 16;
+constexpr int kMaxGnssOutages = 16;
 
 enum class SegmentType : std::uint8_t { kStraight, kArc, kSpin, kFigureEight, kStop };
 
@@ -106,6 +107,38 @@ struct SimImuConfig {
   double temperature_c = 30.0;
 };
 
+struct GnssOutage {
+  double start_s = 0.0;
+  double duration_s = 0.0;
+};
+
+// [gnss]: a u-blox receiver on the robot, its antenna's error as a 1 m-class
+// receiver has it: a bias that wanders slowly (first-order Gauss-Markov per
+// axis), white noise on top, now and then a multipath jump of a few epochs,
+// and outages (a bridge, a tunnel) where it reports no fix.
+struct SimGnssConfig {
+  bool enabled = false;
+  double rate_hz = 5.0;
+  // Where the drive's origin is on the earth; the world frame's x axis
+  // points east, y north.
+  double latitude_deg = 47.3977;
+  double longitude_deg = 8.5456;
+  double altitude_m = 488.0;
+  double latency_s = 0.1;            // from the epoch to its first byte
+  double bias_sigma_m = 0.7;         // horizontal, per axis
+  double vertical_bias_sigma_m = 1.5;
+  double bias_time_s = 60.0;         // correlation time
+  double noise_m = 0.25;             // white, horizontal, per axis
+  double vertical_noise_m = 0.5;
+  double multipath_per_hour = 20.0;  // jumps
+  double multipath_m = 12.0;         // their size
+  int multipath_epochs = 3;          // their length
+  int satellites = 14;
+  std::array<double, 3> antenna_xyz_m{};  // in base_link
+  int outage_count = 0;
+  std::array<GnssOutage, kMaxGnssOutages> outages{};
+};
+
 struct DriveScenario {
   std::string source;   // the file it came from
   double duration_s = 0.0;  // the run; 0 = as long as the path takes
@@ -117,6 +150,7 @@ struct DriveScenario {
   int dropout_count = 0;
   std::array<EncoderDropout, kMaxDropouts> dropouts{};
   SimImuConfig imu;
+  SimGnssConfig gnss;
 };
 
 // Reads and validates a scenario. On failure returns false and sets *error

@@ -71,6 +71,18 @@ std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg,
   r->t0_ = t0;
   r->encoders_ = std::make_unique<SimEncoders>(r->scenario_, *r->truth_, clock, t0);
   r->imu_ = std::make_unique<SimImu>(r->scenario_, *r->truth_, clock, t0);
+  if (hw.gnss.enabled) {
+    if (!r->scenario_.gnss.enabled) {
+      *error = cfg.source + ": [gnss] is configured but the scenario " + path +
+               " has no [gnss] receiver on the simulated robot";
+      return nullptr;
+    }
+    if (hw.gnss.protocol != GnssProtocolConfig::kUbx) {
+      *error = cfg.source + ": gnss.protocol: the simulated receiver speaks ubx (u-blox NAV-PVT)";
+      return nullptr;
+    }
+    r->gnss_ = std::make_unique<SimGnss>(r->scenario_, *r->truth_, clock, t0);
+  }
   if (hw.camera.enabled) {
     r->camera_ = SimCamera::create(cfg, *r->truth_, clock, t0, r->scenario_.seed, error);
     if (!r->camera_) return nullptr;
@@ -84,6 +96,10 @@ HalBuses SimulatedRobot::buses() {
   b.imu.i2c = imu_.get();
   b.imu.data_ready = imu_.get();
   b.imu.clock = clock_;
+  if (gnss_) {
+    b.gnss.serial = gnss_.get();
+    b.gnss.clock = clock_;
+  }
   if (camera_) {
     b.camera.video = &camera_->stream();
     b.camera.clock = clock_;
@@ -110,6 +126,7 @@ const std::uint8_t* GroundTruthEncoder::encode(const TruthState& truth, TimeNs s
 TimeNs SimulatedRobot::next_event_time(std::string_view name) const noexcept {
   if (name == "imu" && imu_) return imu_->next_edge_time();
   if (name == "camera" && camera_) return camera_->next_frame_time();
+  if (name == "gnss" && gnss_) return gnss_->next_arrival();
   return std::numeric_limits<TimeNs>::max();
 }
 

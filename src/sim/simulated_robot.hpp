@@ -16,6 +16,7 @@
 #include "sim/drive_scenario.hpp"
 #include "sim/sim_camera.hpp"
 #include "sim/sim_encoders.hpp"
+#include "sim/sim_gnss.hpp"
 #include "sim/sim_imu.hpp"
 #include "sim/truth_trajectory.hpp"
 
@@ -38,6 +39,7 @@ class SimulatedRobot {
   SimImu& imu() { return *imu_; }
   SimEncoders& encoders() { return *encoders_; }
   SimCamera* camera() { return camera_.get(); }  // null without [camera]
+  SimGnss* gnss() { return gnss_.get(); }        // null without [gnss]
   TimeNs start_time() const { return t0_; }
   // The drive's length (scenario duration, or the path's).
   double duration_s() const;
@@ -56,6 +58,7 @@ class SimulatedRobot {
   std::unique_ptr<SimEncoders> encoders_;
   std::unique_ptr<SimImu> imu_;
   std::unique_ptr<SimCamera> camera_;
+  std::unique_ptr<SimGnss> gnss_;
   hal::Clock* clock_ = nullptr;
   TimeNs t0_ = 0;
 };

@@ -37,7 +37,7 @@ DriveScenario load_ok(const std::string& text) {
 }
 
 TEST(DriveScenario, ShippedScenariosLoadAndCanBeDriven) {
-  for (const char* name : {"straight", "turns", "figure_eight", "slip", "dropout", "demo"}) {
+  for (const char* name : {"straight", "turns", "figure_eight", "slip", "dropout", "demo", "gnss_loop"}) {
     const std::string path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/" + name + ".toml";
     DriveScenario sc;
     std::string error;
@@ -392,6 +392,40 @@ TEST(DriveScenario, SyntaxErrorsAndUnreadableFiles) {
   std::string error;
   EXPECT_FALSE(load_drive_scenario("/nonexistent/scenario.toml", &sc, &error));
   EXPECT_EQ(error, "/nonexistent/scenario.toml: cannot read the scenario: No such file or directory");
+}
+
+}  // namespace
+}  // namespace rtfuse::sim
+
+namespace rtfuse::sim {
+namespace {
+
+TEST(DriveScenario, GnssReceiverAndItsOutages) {
+  const std::string path = "[[path]]\ntype = \"straight\"\nlength_m = 10.0\nspeed_mps = 1.0\n" + kRobot;
+  EXPECT_FALSE(load_ok(path).gnss.enabled);
+  const DriveScenario sc = load_ok(path + R"(
+[gnss]
+rate_hz = 10.0
+latitude_deg = -33.86
+longitude_deg = 151.21
+bias_sigma_m = 0.5
+antenna_xyz_m = [0.1, 0.0, 1.2]
+[[gnss.outage]]
+start_s = 3.0
+duration_s = 2.0
+)");
+  EXPECT_TRUE(sc.gnss.enabled);
+  EXPECT_EQ(sc.gnss.rate_hz, 10.0);
+  EXPECT_EQ(sc.gnss.latitude_deg, -33.86);
+  EXPECT_EQ(sc.gnss.bias_sigma_m, 0.5);
+  EXPECT_EQ(sc.gnss.antenna_xyz_m[2], 1.2);
+  ASSERT_EQ(sc.gnss.outage_count, 1);
+  EXPECT_EQ(sc.gnss.outages[0].start_s, 3.0);
+  EXPECT_NE(load_error(path + "[gnss]\nlatitude_deg = 89.0\n").find("gnss.latitude_deg: must be within -84..84"),
+            std::string::npos);
+  EXPECT_NE(load_error(path + "[gnss]\nrate = 5.0\n").find("gnss.rate: unknown key (did you mean 'rate_hz'?)"), std::string::npos)
+      << load_error(path + "[gnss]\nrate = 5.0\n");
+  EXPECT_NE(load_error(path + "[gnss]\n[[gnss.outage]]\nstart_s = 1.0\n").find("duration_s"), std::string::npos);
 }
 
 }  // namespace
