@@ -81,6 +81,7 @@ bool FusionCore::configure_navsat(std::string* error) {
     if (c.heading_sensor >= 0) heading_targets_[c.heading_sensor] |= 1u << i;
   }
   slots_ = device_slots(cfg_);
+  for (int& key : navsat_message_key_) key = -1;
   if (slots_.num_navsat > 0) {
     const auto layout = std::make_unique<DeviceStatus[]>(kMaxDevices);
     describe_devices(cfg_, layout.get(), kMaxDevices);
@@ -94,7 +95,7 @@ bool FusionCore::configure_navsat(std::string* error) {
   return true;
 }
 
-void FusionCore::fill_navsat(Snapshot& s) const noexcept {
+void FusionCore::fill_navsat(Snapshot& s) noexcept {
   if (slots_.num_navsat == 0) return;
   if (s.num_devices < slots_.count) s.num_devices = slots_.count;
   for (int k = 0; k < slots_.num_navsat; ++k) {
@@ -113,16 +114,21 @@ void FusionCore::fill_navsat(Snapshot& s) const noexcept {
       d.state = "datum set";
       d.level = n.last() == est::NavsatRejection::kNone ? DeviceLevel::kOk : DeviceLevel::kWarn;
     }
-    if (n.last() != est::NavsatRejection::kNone) {
-      char text[96];
-      std::snprintf(text, sizeof text, "last fix refused: %s", est::to_string(n.last()));
-      set_device_message(d.message, text);
-    } else if (n.has_transform()) {
-      char text[96];
-      std::snprintf(text, sizeof text, "datum %.7f %.7f %.2f m", n.plane().datum().latitude_deg,
-                    n.plane().datum().longitude_deg, n.plane().datum().altitude_m);
-      set_device_message(d.message, text);
+    // The text changes only with the verdict or the datum: formatted then,
+    // not every tick.
+    const int key = static_cast<int>(n.last()) * 2 + (n.has_transform() ? 1 : 0);
+    if (key != navsat_message_key_[k]) {
+      navsat_message_key_[k] = key;
+      char text[96] = "";
+      if (n.last() != est::NavsatRejection::kNone) {
+        std::snprintf(text, sizeof text, "last fix refused: %s", est::to_string(n.last()));
+      } else if (n.has_transform()) {
+        std::snprintf(text, sizeof text, "datum %.7f %.7f %.2f m", n.plane().datum().latitude_deg,
+                      n.plane().datum().longitude_deg, n.plane().datum().altitude_m);
+      }
+      set_device_message(navsat_message_[k], text);
     }
+    d.message = navsat_message_[k];
   }
 }
 

@@ -59,7 +59,7 @@ class FusionCore {
   void fuse(const est::SensorSample& s, TimeNs now) noexcept;
   void publish_snapshot(TimeNs now, const LoopStats& loop) noexcept;
   // The navsat transforms' slots of the diagnostics.
-  void fill_navsat(Snapshot& s) const noexcept;
+  void fill_navsat(Snapshot& s) noexcept;
 
   RuntimeConfig cfg_;
   geometry::FrameTree frames_;
@@ -74,6 +74,8 @@ class FusionCore {
   DeviceSlots slots_;
   int navsat_sensor_[kMaxNavsatSensors] = {};
   DeviceStatus navsat_layout_[kMaxNavsatSensors];  // names and ids
+  DeviceMessage navsat_message_[kMaxNavsatSensors];
+  int navsat_message_key_[kMaxNavsatSensors] = {};  // -1 until formatted (configure_navsat)
   static_assert(kMaxSensors <= 32, "heading_targets_ is a bit set");
   std::unique_ptr<est::SensorSample[]> staging_;
   int staging_capacity_ = 0;
