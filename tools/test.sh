@@ -12,14 +12,20 @@
 # run; CI runs them all).
 set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
-"$root/tools/setup-deps.sh"
-"$root/tools/build.sh" test
-(cd "$root/build/test" && ctest --output-on-failure -j2 "$@")
+# Each stage's wall time is printed so the CI budget can be watched.
+stage() {
+  local start=$SECONDS
+  "$@"
+  echo "test.sh: stage '$*' took $((SECONDS - start)) s" >&2
+}
+stage "$root/tools/setup-deps.sh"
+stage "$root/tools/build.sh" test
+(cd "$root/build/test" && stage ctest --output-on-failure -j2 "$@")
 if [[ "${RTFUSE_SANITIZERS:-1}" != 0 ]]; then
-  "$root/tools/sanitize.sh" asan "$@"
-  "$root/tools/fuzz.sh" --regression
-  "$root/tools/sanitize.sh" tsan
+  stage "$root/tools/sanitize.sh" asan "$@"
+  stage "$root/tools/fuzz.sh" --regression
+  stage "$root/tools/sanitize.sh" tsan
 fi
 if [[ "${RTFUSE_CROSS:-1}" != 0 ]]; then
-  "$root/tools/test-cross.sh" "$@"
+  stage "$root/tools/test-cross.sh" "$@"
 fi
