@@ -37,7 +37,7 @@ void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::Snapshot& s, std
                 ", \"rejected_stale\": %" PRId64 ", \"rejected_overflow\": %" PRId64 ", \"rejected_rate\": %" PRId64
                 ", \"rejected_oversize\": %" PRId64 ", \"decode_errors\": %" PRId64 ", \"yaw_conflicts\": %" PRId64
                 "}",
-                i ? ", " : "", cfg.sensors[i].name.c_str(), st.received, st.accepted, rtfuse::rejected_total(st),
+                i ? ", " : "", rtfuse::qualified_sensor_name(cfg, i).c_str(), st.received, st.accepted, rtfuse::rejected_total(st),
                 st.rejected_mahalanobis, st.rejected_invalid, st.rejected_stale, st.rejected_overflow,
                 st.rejected_rate, st.rejected_oversize, st.decode_errors, st.yaw_conflicts);
   }
@@ -47,6 +47,22 @@ void print_json(const rtfuse::RuntimeConfig& cfg, const rtfuse::Snapshot& s, std
     const rtfuse::DeviceStatus& d = s.devices[i];
     std::printf("%s\"%s\": {\"state\": \"%s\"", i ? ", " : "", d.name.c_str(), d.state.c_str());
     for (int k = 0; k < d.num_values; ++k) std::printf(", \"%s\": %" PRId64, d.keys[k], d.values[k]);
+    std::printf("}");
+  }
+  // Every filter instance by name, the first included (its values are the
+  // top-level keys too).
+  std::printf("}, \"instances\": {");
+  for (int k = 0; k < s.num_instances; ++k) {
+    const rtfuse::InstanceSnapshot& in = s.instances[k];
+    const double* state = k == 0 ? s.state : in.state;
+    std::printf("%s\"%s\": {", k ? ", " : "", cfg.instances[static_cast<std::size_t>(k)].name.c_str());
+    for (int i = 0; i < 9; ++i) std::printf("\"%s\": %.17g, ", kKeys[i], state[i]);
+    std::printf("\"world_frame\": \"%s\", \"initialized\": %s, \"fixes_fused\": %" PRId64,
+                rtfuse::instance_world_frame(cfg, k).c_str(), in.initialized ? "true" : "false", in.fixes_fused);
+    if (in.has_map_odom) {
+      std::printf(", \"map_odom\": [%.17g, %.17g, %.17g]", in.map_odom_translation[0], in.map_odom_translation[1],
+                  in.map_odom_translation[2]);
+    }
     std::printf("}");
   }
   std::printf("}%s}\n", extra.c_str());

@@ -17,6 +17,9 @@ constexpr int kMaxSensors = 16;
 // GNSS receivers a robot carries (a dual-antenna set-up at most).
 constexpr int kMaxNavsatSensors = 2;
 constexpr int kMaxStaticTransforms = 24;
+// Filter instances in one process: robot_localization's dual EKF (a local
+// one in odom, a global one in map) and one more, e.g. to compare tunings.
+constexpr int kMaxInstances = 3;
 
 using Name = FixedString<63>;
 
@@ -39,6 +42,13 @@ struct SensorConfig {
   Name antenna_frame;
   Name heading_imu;
   int heading_sensor = -1;
+  // The filter instance that fuses it (0: [filter] and the top-level
+  // [[sensor]]s; k: the k-th [[instance]] after it).
+  int instance = 0;
+  // The sensor whose ring carries its samples: itself (-1, or its own index)
+  // or an earlier one of another instance on the same source, so that one
+  // message or one driver feeds every instance that fuses it.
+  int input = -1;
 };
 
 struct StaticTransformConfig {
@@ -75,6 +85,24 @@ struct PublishConfig {
   double state_rate_hz = 10.0;
   double diagnostics_rate_hz = 1.0;
   bool publish_tf = true;
+};
+
+// A filter instance after the first (the first is [filter], world_frame and
+// the top-level sensors): its own EKF, sensors, and outputs under
+// rtfuse/<name>/. docs/configuration.md, "[[instance]]".
+struct InstanceConfig {
+  Name name{"local"};
+  Name world_frame{"map"};
+  est::FilterParams filter;  // [filter]'s values where the instance gives none
+  Name odometry_channel;     // rtfuse/<name>/odometry ...
+  Name pose_channel;
+  Name state_channel;
+  Name filtered_fix_channel;  // rtfuse/<name>/gps/filtered (navsat sensors only)
+  double odometry_rate_hz = 50.0;
+  double pose_rate_hz = 50.0;
+  double state_rate_hz = 10.0;
+  double tf_rate_hz = 50.0;   // map -> odom on [publish] tf_channel
+  double filtered_fix_rate_hz = 10.0;
 };
 
 // The built-in simulated robot (config/sim.toml): a figure-eight drive with
@@ -126,6 +154,31 @@ struct RuntimeConfig {
   int num_static_transforms = 0;
   LcmSimConfig sim;
   HardwareConfig hardware;
+  // instances[0] holds the first instance's name and filtered-fix channel
+  // only: its filter and frame are `filter` and `world_frame` above.
+  std::array<InstanceConfig, kMaxInstances> instances{};
+  int num_instances = 1;
 };
+
+inline const est::FilterParams& instance_filter(const RuntimeConfig& c, int k) {
+  return k == 0 ? c.filter : c.instances[static_cast<std::size_t>(k)].filter;
+}
+inline const Name& instance_world_frame(const RuntimeConfig& c, int k) {
+  return k == 0 ? c.world_frame : c.instances[static_cast<std::size_t>(k)].world_frame;
+}
+// The index of the sensor whose ring carries sensor i's samples.
+inline int sensor_input(const RuntimeConfig& c, int i) {
+  const int in = c.sensors[static_cast<std::size_t>(i)].input;
+  return in < 0 ? i : in;
+}
+// "odom0" for the first instance's sensors, "global/odom0" for the others':
+// the name in diagnostics and the replay's JSON.
+inline Name qualified_sensor_name(const RuntimeConfig& c, int i) {
+  const SensorConfig& s = c.sensors[static_cast<std::size_t>(i)];
+  if (s.instance == 0) return s.name;
+  // Truncated past Name's capacity (the explicit constructor cuts).
+  return Name(std::string(c.instances[static_cast<std::size_t>(s.instance)].name.view()) + "/" +
+              std::string(s.name.view()));
+}
 
 }  // namespace rtfuse

@@ -59,8 +59,51 @@ void frames_must_differ(const Section& s, std::string_view a, const Name& va, st
   s.value_error(at, "must differ from " + std::string(other) + " (both " + in_quotes(va.view()) + ")");
 }
 
+// The [filter] keys an [[instance]] may give as well (the loop's rate and
+// the frame names are the process's).
+void read_filter_params(const Section& s, est::FilterParams& f) {
+  read_number(s, "sensor_timeout", f.sensor_timeout_s, positive_finite, "must be > 0 s and finite");
+  s.read("two_d_mode", f.two_d_mode);
+  read_covariance(s, "process_noise_covariance", f.process_noise);
+  read_covariance(s, "initial_estimate_covariance", f.initial_covariance);
+  s.read("dynamic_process_noise_covariance", f.dynamic_process_noise);
+  if (const auto x0 = read_fixed(s, "initial_state", est::kStateSize, kStateList)) {
+    f.has_initial_state = true;
+    f.initial_state = Eigen::Map<const est::StateVector>(x0->data());
+  }
+  read_number(s, "max_variance", f.max_variance, positive, "must be > 0");
+  s.read("smooth_lagged_data", f.smooth_lagged_data);
+  const bool history_ok = read_number(s, "history_length", f.history_length_s, non_negative_finite,
+                                      "must be >= 0 s and finite");
+  if (f.smooth_lagged_data && !(f.history_length_s > 0) && (history_ok || !s.has("history_length"))) {
+    const std::string_view at = s.has("history_length") ? "history_length" : "smooth_lagged_data";
+    s.diag().add(s.value_where(at), s.key("history_length"),
+                 "must be > 0 s when smooth_lagged_data is true, got " + fmt(f.history_length_s));
+  }
+  read_number(s, "gravitational_acceleration", f.gravity, non_negative_finite, "must be >= 0 and finite");
+  read_number(s, "yaw_conflict_gate", f.yaw_conflict_gate_sigma, positive, "must be > 0");
+}
+
+// An instance's name is a channel prefix (rtfuse/<name>/odometry) and a key
+// of the replay's JSON: short, lower case, no separators.
+bool read_instance_name(const Section& s, Name& out) {
+  std::string name;
+  if (!s.read("name", name)) return false;
+  const bool ok = !name.empty() && name.size() <= 15 &&
+                  std::all_of(name.begin(), name.end(), [](char c) {
+                    return (c >= 'a' && c <= 'z') || (c >= '0' && c <= '9') || c == '_';
+                  });
+  if (!ok) {
+    s.value_error("name", "must be 1 to 15 characters of a-z, 0-9 and _ (it names the instance's channels, "
+                          "rtfuse/<name>/...), got " + in_quotes(name));
+    return false;
+  }
+  out = Name(name);
+  return true;
+}
+
 void read_filter(const Section& s, RuntimeConfig& cfg) {
-  s.reject_unknown({"frequency", "sensor_timeout", "two_d_mode", "world_frame", "odom_frame",
+  s.reject_unknown({"name", "frequency", "sensor_timeout", "two_d_mode", "world_frame", "odom_frame",
                     "base_link_frame", "map_frame", "process_noise_covariance",
                     "initial_estimate_covariance", "dynamic_process_noise_covariance",
                     "initial_state", "max_variance", "smooth_lagged_data", "history_length",
@@ -69,8 +112,7 @@ void read_filter(const Section& s, RuntimeConfig& cfg) {
   read_number(s, "frequency", cfg.rate_hz, [](double v) { return v > 0 && v <= 10000; },
               "must be > 0 and <= 10000 Hz");
   f.sensor_timeout_s = 1.0 / cfg.rate_hz;
-  read_number(s, "sensor_timeout", f.sensor_timeout_s, positive_finite, "must be > 0 s and finite");
-  s.read("two_d_mode", f.two_d_mode);
+  read_instance_name(s, cfg.instances[0].name);
 
   s.read_name("odom_frame", cfg.odom_frame);
   s.read_name("base_link_frame", cfg.base_link_frame);
@@ -89,25 +131,8 @@ void read_filter(const Section& s, RuntimeConfig& cfg) {
   frames_must_differ(s, "odom_frame", cfg.odom_frame, "map_frame", cfg.map_frame);
 
   f.process_noise = Eigen::Map<const est::StateVector>(kDefaultProcessNoise.data()).asDiagonal();
-  read_covariance(s, "process_noise_covariance", f.process_noise);
   f.initial_covariance = StateMatrix::Identity() * kDefaultInitialVariance;
-  read_covariance(s, "initial_estimate_covariance", f.initial_covariance);
-  s.read("dynamic_process_noise_covariance", f.dynamic_process_noise);
-  if (const auto x0 = read_fixed(s, "initial_state", est::kStateSize, kStateList)) {
-    f.has_initial_state = true;
-    f.initial_state = Eigen::Map<const est::StateVector>(x0->data());
-  }
-  read_number(s, "max_variance", f.max_variance, positive, "must be > 0");
-  s.read("smooth_lagged_data", f.smooth_lagged_data);
-  const bool history_ok = read_number(s, "history_length", f.history_length_s, non_negative_finite,
-                                      "must be >= 0 s and finite");
-  if (f.smooth_lagged_data && !(f.history_length_s > 0) && (history_ok || !s.has("history_length"))) {
-    const std::string_view at = s.has("history_length") ? "history_length" : "smooth_lagged_data";
-    s.diag().add(s.value_where(at), s.key("history_length"),
-                 "must be > 0 s when smooth_lagged_data is true, got " + fmt(f.history_length_s));
-  }
-  read_number(s, "gravitational_acceleration", f.gravity, non_negative_finite, "must be >= 0 and finite");
-  read_number(s, "yaw_conflict_gate", f.yaw_conflict_gate_sigma, positive, "must be > 0");
+  read_filter_params(s, f);
 }
 
 void read_realtime(const Section& s, RealtimeConfig& rt) {
@@ -395,24 +420,43 @@ SensorEntry read_sensor(const Section& s) {
   return e;
 }
 
-void read_sensors(const Section& root, RuntimeConfig& cfg, const std::vector<ChannelUse>& publish) {
-  for_each_table(root, "sensor", kMaxSensors, [&](const Section& s, bool fits) {
-    const SensorEntry e = read_sensor(s);
-    for (int j = 0; j < cfg.num_sensors && e.has_name; ++j) {
+// The [[sensor]] tables of one instance (the top level's for the first, an
+// [[instance]]'s own for the others), appended to cfg.sensors. A sensor on
+// the source of an earlier instance's sensor (the same channel, or the same
+// driver) shares its ring: one message, one fusion per instance.
+void read_sensors(const Section& parent, RuntimeConfig& cfg, const std::vector<ChannelUse>& publish, int instance,
+                  std::vector<config::SensorSite>& sites) {
+  const int first = cfg.num_sensors;
+  const std::string instance_words =
+      instance == 0 ? "" : " in instance " + in_quotes(cfg.instances[static_cast<std::size_t>(instance)].name.view());
+  for_each_table(parent, "sensor", kMaxSensors - first, [&](const Section& s, bool fits) {
+    SensorEntry e = read_sensor(s);
+    e.cfg.instance = instance;
+    for (int j = first; j < cfg.num_sensors && e.has_name; ++j) {
       if (cfg.sensors[static_cast<std::size_t>(j)].name == e.cfg.name) {
-        s.value_error("name", "duplicate sensor name " + in_quotes(e.cfg.name.view()) + " (also sensor[" +
-                                  std::to_string(j) + "])");
+        s.value_error("name", "duplicate sensor name " + in_quotes(e.cfg.name.view()) + instance_words + " (also " +
+                                  sites[static_cast<std::size_t>(j)].key + ")");
         break;
       }
     }
     bool channel_taken = false;
     for (int j = 0; j < cfg.num_sensors && e.has_channel; ++j) {
-      if (cfg.sensors[static_cast<std::size_t>(j)].channel == e.cfg.channel) {
-        s.value_error("channel", "channel " + in_quotes(e.cfg.channel.view()) + " is also sensor[" +
-                                     std::to_string(j) + "].channel");
-        channel_taken = true;
+      const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];
+      if (o.channel != e.cfg.channel) continue;
+      if (o.instance == instance) {
+        s.value_error("channel", "channel " + in_quotes(e.cfg.channel.view()) + " is also " +
+                                     sites[static_cast<std::size_t>(j)].key + ".channel");
+      } else if (o.params.kind != e.cfg.params.kind) {
+        s.value_error("channel", "channel " + in_quotes(e.cfg.channel.view()) + " is " +
+                                     sites[static_cast<std::size_t>(j)].key + " of type " +
+                                     in_quotes(kind_name(o.params.kind)) +
+                                     ": a sensor of another instance on it must have the same type");
+      } else {
+        e.cfg.input = sensor_input(cfg, j);
         break;
       }
+      channel_taken = true;
+      break;
     }
     for (const ChannelUse& used : publish) {
       if (!channel_taken && e.has_channel && used.name == e.cfg.channel) {
@@ -420,42 +464,135 @@ void read_sensors(const Section& root, RuntimeConfig& cfg, const std::vector<Cha
         break;
       }
     }
+    // A driver's samples: shared with an earlier instance's sensor on it
+    // (two of one instance are read_hardware's error).
+    for (int j = 0; j < first && e.cfg.source != SensorSource::kLcm; ++j) {
+      const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];
+      if (o.source != e.cfg.source || sensor_input(cfg, j) != j) continue;
+      if (o.params.kind != e.cfg.params.kind) {
+        s.value_error("type", "the driver's samples are " + in_quotes(kind_name(o.params.kind)) + " (" +
+                                  sites[static_cast<std::size_t>(j)].key + ")");
+      }
+      e.cfg.input = j;
+      break;
+    }
     if (e.cfg.params.kind == est::SensorKind::kNavSatFix) {
       int navsat = 0;
       for (int j = 0; j < cfg.num_sensors; ++j) {
         if (cfg.sensors[static_cast<std::size_t>(j)].params.kind == est::SensorKind::kNavSatFix) ++navsat;
       }
       if (navsat == kMaxNavsatSensors) {
-        s.value_error("type", "at most " + std::to_string(kMaxNavsatSensors) + " navsat sensors");
+        s.value_error("type", "at most " + std::to_string(kMaxNavsatSensors) + " navsat sensors in all instances");
       }
     }
     // Unnamed entries are still stored (the config is rejected anyway) so
     // that "also sensor[j]" indices match the file.
-    if (fits) cfg.sensors[static_cast<std::size_t>(cfg.num_sensors++)] = e.cfg;
+    if (fits) {
+      sites.push_back({s.path(), s.where()});
+      cfg.sensors[static_cast<std::size_t>(cfg.num_sensors++)] = e.cfg;
+    }
   });
-  // A navsat sensor's heading IMU, by name, once every sensor is known (the
-  // stored sensors are the array's tables within kMaxSensors, in order).
-  const toml::array* entries = config::table_array(root, "sensor");
-  int index = 0;
+  // A navsat sensor's heading IMU, by name among its instance's sensors,
+  // once they are all known.
+  const toml::array* entries = config::table_array(parent, "sensor");
+  int index = first;
   for (std::size_t i = 0; entries != nullptr && i < entries->size() && index < cfg.num_sensors; ++i) {
     const auto* t = entries->get(i)->as_table();
     if (t == nullptr) continue;
-    const Section s(t, root.key("sensor") + "[" + std::to_string(i) + "]", root.diag());
+    const Section s(t, parent.key("sensor") + "[" + std::to_string(i) + "]", parent.diag());
     SensorConfig& c = cfg.sensors[static_cast<std::size_t>(index++)];
     if (c.heading_imu.empty()) continue;
-    for (int j = 0; j < cfg.num_sensors && c.heading_sensor < 0; ++j) {
+    for (int j = first; j < cfg.num_sensors && c.heading_sensor < 0; ++j) {
       const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];
       if (o.name != c.heading_imu) continue;
-      if (o.params.kind != est::SensorKind::kImu || !est::mask_has(o.params.update_mask, est::kYaw)) {
-        s.value_error("heading_imu", in_quotes(c.heading_imu.view()) + " is not an imu sensor that fuses yaw");
+      // navsat_transform reads the IMU's orientation whether or not the
+      // filter fuses its yaw (robot_localization's example fuses none).
+      if (o.params.kind != est::SensorKind::kImu) {
+        s.value_error("heading_imu", in_quotes(c.heading_imu.view()) + " is not an imu sensor");
         break;
       }
       c.heading_sensor = j;
     }
-    const bool named = std::any_of(cfg.sensors.begin(), cfg.sensors.begin() + cfg.num_sensors,
+    const bool named = std::any_of(cfg.sensors.begin() + first, cfg.sensors.begin() + cfg.num_sensors,
                                    [&](const SensorConfig& o) { return o.name == c.heading_imu; });
-    if (!named) s.value_error("heading_imu", "no sensor is named " + in_quotes(c.heading_imu.view()));
+    if (!named) s.value_error("heading_imu", "no sensor" + instance_words + " is named " + in_quotes(c.heading_imu.view()));
   }
+}
+
+constexpr std::string_view kInstanceRates[] = {"odometry_rate", "pose_rate", "state_rate", "tf_rate",
+                                               "filtered_fix_rate"};
+
+// [[instance]]: a further filter: its name, world frame, the [filter] keys
+// it changes, its output rates, and its own [[instance.sensor]] tables.
+void read_instance(const Section& s, RuntimeConfig& cfg, int k, std::vector<ChannelUse>& channels,
+                   std::vector<config::SensorSite>& sites) {
+  s.reject_unknown({"name", "world_frame", "sensor_timeout", "two_d_mode", "process_noise_covariance",
+                    "initial_estimate_covariance", "dynamic_process_noise_covariance", "initial_state",
+                    "max_variance", "smooth_lagged_data", "history_length", "gravitational_acceleration",
+                    "yaw_conflict_gate", "odometry_rate", "pose_rate", "state_rate", "tf_rate", "filtered_fix_rate",
+                    "sensor"});
+  s.require({"name", "sensor"});
+  InstanceConfig& in = cfg.instances[static_cast<std::size_t>(k)];
+  in.filter = cfg.filter;
+  in.world_frame = cfg.map_frame;
+  if (read_instance_name(s, in.name)) {
+    for (int j = 0; j < k; ++j) {
+      if (cfg.instances[static_cast<std::size_t>(j)].name == in.name) {
+        s.value_error("name", "instance name " + in_quotes(in.name.view()) + " is also " +
+                                  (j == 0 ? std::string("the first instance's ([filter] name, default 'local')")
+                                          : "instance[" + std::to_string(j - 1) + "].name"));
+        break;
+      }
+    }
+  }
+  if (s.read_name("world_frame", in.world_frame) && in.world_frame != cfg.odom_frame &&
+      in.world_frame != cfg.map_frame) {
+    s.value_error("world_frame", "must equal odom_frame (" + in_quotes(cfg.odom_frame.view()) + ") or map_frame (" +
+                                     in_quotes(cfg.map_frame.view()) + "), got " + in_quotes(in.world_frame.view()));
+  }
+  read_filter_params(s, in.filter);
+  const PublishConfig& p = cfg.publish;
+  in.odometry_rate_hz = p.odometry_rate_hz;
+  in.pose_rate_hz = p.pose_rate_hz;
+  in.state_rate_hz = p.state_rate_hz;
+  in.tf_rate_hz = p.tf_rate_hz;
+  double* const rates[] = {&in.odometry_rate_hz, &in.pose_rate_hz, &in.state_rate_hz, &in.tf_rate_hz,
+                           &in.filtered_fix_rate_hz};
+  for (std::size_t r = 0; r < std::size(kInstanceRates); ++r) {
+    read_number(s, kInstanceRates[r], *rates[r], [](double v) { return v >= 0 && v <= 10000; },
+                "must be >= 0 and <= 10000 Hz (0 disables)");
+  }
+  const std::string prefix = "rtfuse/" + std::string(in.name.view()) + "/";
+  in.odometry_channel = Name(prefix + "odometry");
+  in.pose_channel = Name(prefix + "pose");
+  in.state_channel = Name(prefix + "state");
+  in.filtered_fix_channel = Name(prefix + "gps/filtered");
+  for (const Name* c : {&in.odometry_channel, &in.pose_channel, &in.state_channel, &in.filtered_fix_channel}) {
+    for (const ChannelUse& used : channels) {
+      if (used.name == *c) {
+        s.value_error("name", "its channel " + in_quotes(c->view()) + " is also " + used.key);
+        break;
+      }
+    }
+    channels.push_back({*c, s.key("name") + " (its outputs)"});
+  }
+  const int before = cfg.num_sensors;
+  read_sensors(s, cfg, channels, k, sites);
+  if (cfg.num_sensors == before && s.has("sensor") && config::table_array(s, "sensor") != nullptr &&
+      config::table_array(s, "sensor")->empty()) {
+    s.key_error("sensor", "an instance needs at least one [[instance.sensor]]");
+  }
+}
+
+void read_instances(const Section& root, RuntimeConfig& cfg, std::vector<ChannelUse>& channels,
+                    std::vector<config::SensorSite>& sites) {
+  cfg.instances[0].filtered_fix_channel = Name("rtfuse/gps/filtered");
+  channels.push_back({cfg.instances[0].filtered_fix_channel, "the first instance's filtered fix"});
+  for_each_table(root, "instance", kMaxInstances - 1, [&](const Section& s, bool fits) {
+    if (!fits) return;
+    read_instance(s, cfg, cfg.num_instances, channels, sites);
+    ++cfg.num_instances;
+  });
 }
 
 void read_static_transform(const Section& s, StaticTransformConfig& out) {
@@ -532,22 +669,24 @@ void read_sim(const Section& s, LcmSimConfig& sim) {
 }
 
 void read_root(const Section& root, RuntimeConfig& cfg) {
-  root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "static_transform", "sim", "hardware",
-                       "can", "wheel_odometry", "mpu", "camera", "vo", "gnss"});
+  root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "instance", "static_transform", "sim",
+                       "hardware", "can", "wheel_odometry", "mpu", "camera", "vo", "gnss"});
   Diagnostics& d = root.diag();
   read_filter(Section(section_table(root, "filter"), "filter", d), cfg);
   read_realtime(Section(section_table(root, "realtime"), "realtime", d), cfg.realtime);
   read_lcm(Section(section_table(root, "lcm"), "lcm", d), cfg);
   std::vector<ChannelUse> publish_channels;
   read_publish(Section(section_table(root, "publish"), "publish", d), cfg.publish, publish_channels);
-  read_sensors(root, cfg, publish_channels);
+  std::vector<config::SensorSite> sites;
+  read_sensors(root, cfg, publish_channels, 0, sites);
+  read_instances(root, cfg, publish_channels, sites);
   // Absent max_rate: what the loop drains per second (2 x queue_size a tick).
   for (int i = 0; i < cfg.num_sensors; ++i) {
     SensorConfig& sc = cfg.sensors[static_cast<std::size_t>(i)];
     if (sc.max_rate_hz == 0.0) sc.max_rate_hz = 2.0 * sc.params.queue_size * cfg.rate_hz;
   }
   read_static_transforms(root, cfg);
-  config::read_hardware(root, cfg);
+  config::read_hardware(root, cfg, sites);
   read_sim(Section(section_table(root, "sim"), "sim", d), cfg.sim);
 }
 

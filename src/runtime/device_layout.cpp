@@ -151,7 +151,7 @@ int describe_devices(const RuntimeConfig& cfg, DeviceStatus* out, int max) noexc
     const SensorConfig& c = cfg.sensors[static_cast<std::size_t>(i)];
     if (c.params.kind != est::SensorKind::kNavSatFix) continue;
     DeviceStatus& d = out[slots.first_navsat + k++];
-    std::snprintf(buf, sizeof buf, "navsat %s", c.name.c_str());
+    std::snprintf(buf, sizeof buf, "navsat %s", qualified_sensor_name(cfg, i).c_str());
     d.name = buf;
     d.hardware_id = c.channel.empty() ? c.name.c_str() : c.channel.c_str();
     keys(d, kNavsatKeys, kNavsatKeyCount);

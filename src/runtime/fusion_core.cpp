@@ -16,17 +16,25 @@ std::unique_ptr<FusionCore> FusionCore::create(const RuntimeConfig& cfg, std::st
 }
 
 FusionCore::FusionCore(const RuntimeConfig& cfg) : cfg_(cfg) {
-  filter_ = std::make_unique<est::Filter>(cfg_.filter);
-  int absolute_yaw_sources = 0;
+  num_instances_ = cfg_.num_instances < 1 ? 1 : (cfg_.num_instances > kMaxInstances ? kMaxInstances : cfg_.num_instances);
+  for (int k = 0; k < num_instances_; ++k) {
+    instances_[k].filter = std::make_unique<est::Filter>(instance_filter(cfg_, k));
+  }
+  int absolute_yaw_sources[kMaxInstances] = {};
   for (int i = 0; i < cfg_.num_sensors; ++i) {
-    models_[i] = est::SensorModel(static_cast<std::uint8_t>(i), cfg_.sensors[i].params, cfg_.filter);
-    if (models_[i].fuses_absolute_yaw()) ++absolute_yaw_sources;
-    staging_capacity_ += 2 * cfg_.sensors[i].params.queue_size;
+    const SensorConfig& c = cfg_.sensors[i];
+    const int k = c.instance < num_instances_ ? c.instance : 0;
+    models_[i] = est::SensorModel(static_cast<std::uint8_t>(i), c.params, instance_filter(cfg_, k));
+    if (models_[i].fuses_absolute_yaw()) ++absolute_yaw_sources[k];
+    fused_by_[sensor_input(cfg_, i)] |= 1u << i;
+    // A shared input's ring is its first sensor's: staged once.
+    if (sensor_input(cfg_, i) == i) staging_capacity_ += 2 * c.params.queue_size;
   }
   // One absolute yaw source cannot conflict with anything; two can, and then
   // robot_localization would pull the estimate back and forth between them.
-  if (absolute_yaw_sources >= 2) {
-    for (int i = 0; i < cfg_.num_sensors; ++i) models_[i].set_yaw_gate(cfg_.filter.yaw_conflict_gate_sigma);
+  for (int i = 0; i < cfg_.num_sensors; ++i) {
+    const int k = cfg_.sensors[i].instance < num_instances_ ? cfg_.sensors[i].instance : 0;
+    if (absolute_yaw_sources[k] >= 2) models_[i].set_yaw_gate(instance_filter(cfg_, k).yaw_conflict_gate_sigma);
   }
   staging_ = std::make_unique<est::SensorSample[]>(static_cast<std::size_t>(staging_capacity_ > 0 ? staging_capacity_ : 1));
 }
@@ -44,14 +52,20 @@ bool FusionCore::build_frames(std::string* error) {
       return false;
     }
   }
-  fusion_frames_.tree = &frames_;
-  fusion_frames_.world = frames_.find(cfg_.world_frame.view());
-  fusion_frames_.base_link = frames_.find(cfg_.base_link_frame.view());
-  if (frames_.lookup(fusion_frames_.base_link, fusion_frames_.world)) {
-    // A static world->base_link transform would pin the robot in place.
-    *error = cfg_.source + ": static transforms connect " + std::string(cfg_.world_frame.view()) + " to " +
-             std::string(cfg_.base_link_frame.view()) + "; the filter estimates that transform itself";
-    return false;
+  for (int k = 0; k < num_instances_; ++k) {
+    Instance& in = instances_[k];
+    const Name& world = instance_world_frame(cfg_, k);
+    in.frames.tree = &frames_;
+    in.frames.world = frames_.find(world.view());
+    in.frames.base_link = frames_.find(cfg_.base_link_frame.view());
+    in.in_map = world == cfg_.map_frame;
+    if (!in.in_map && local_ < 0) local_ = k;
+    if (frames_.lookup(in.frames.base_link, in.frames.world)) {
+      // A static world->base_link transform would pin the robot in place.
+      *error = cfg_.source + ": static transforms connect " + std::string(world.view()) + " to " +
+               std::string(cfg_.base_link_frame.view()) + "; the filter estimates that transform itself";
+      return false;
+    }
   }
   return true;
 }
@@ -77,8 +91,11 @@ bool FusionCore::configure_navsat(std::string* error) {
       *error = where + ": " + why;
       return false;
     }
-    models_[i] = est::SensorModel(static_cast<std::uint8_t>(i), c.params, cfg_.filter);
-    if (c.heading_sensor >= 0) heading_targets_[c.heading_sensor] |= 1u << i;
+    models_[i] = est::SensorModel(static_cast<std::uint8_t>(i), c.params, instance_filter(cfg_, c.instance));
+    if (c.heading_sensor >= 0) heading_targets_[sensor_input(cfg_, c.heading_sensor)] |= 1u << i;
+    Instance& in = instances_[c.instance < num_instances_ ? c.instance : 0];
+    if (in.navsat_sensor < 0) in.navsat_sensor = i;
+    in.needs_fix = in.in_map;
   }
   slots_ = device_slots(cfg_);
   for (int& key : navsat_message_key_) key = -1;
@@ -135,7 +152,7 @@ void FusionCore::fill_navsat(Snapshot& s) noexcept {
 void FusionCore::feed_navsat_heading(const est::SensorSample& s) noexcept {
   // navsat_transform_node's imuCallback: the IMU's orientation, its
   // mounting taken off, until the datum is fixed.
-  const auto base_T_imu = frames_.lookup(fusion_frames_.base_link, s.frame);
+  const auto base_T_imu = frames_.lookup(instances_[0].frames.base_link, s.frame);
   if (!base_T_imu) return;
   const Eigen::Quaterniond base_orientation = s.imu.orientation * base_T_imu->rotation.conjugate();
   for (int j = 0; j < cfg_.num_sensors; ++j) {
@@ -146,31 +163,50 @@ void FusionCore::feed_navsat_heading(const est::SensorSample& s) noexcept {
 }
 
 void FusionCore::apply_set_pose(const SetPoseCommand& cmd) noexcept {
-  const auto world_T_frame = frames_.lookup(fusion_frames_.world, cmd.frame);
-  if (!world_T_frame) {
-    ++set_pose_rejected_;
-    return;
+  // Every instance whose world frame the command's frame is tied to by
+  // static transforms: a pose in odom resets the local instance, one in map
+  // the global one.
+  bool applied = false;
+  for (int k = 0; k < num_instances_; ++k) {
+    Instance& in = instances_[k];
+    const auto world_T_frame = frames_.lookup(in.frames.world, cmd.frame);
+    if (!world_T_frame) continue;
+    geometry::RigidTransform frame_T_base;
+    frame_T_base.translation = cmd.pose.position;
+    frame_T_base.rotation = cmd.pose.orientation;
+    const geometry::RigidTransform world_T_base = *world_T_frame * frame_T_base;
+    est::StateVector x = est::StateVector::Zero();
+    x.segment<3>(est::kX) = world_T_base.translation;
+    x.segment<3>(est::kRoll) = geometry::rpy_from_quaternion(world_T_base.rotation);
+    // Velocities and accelerations restart at zero with the initial
+    // uncertainty; the pose takes the command's covariance, as
+    // robot_localization's set_pose.
+    est::StateMatrix p = instance_filter(cfg_, k).initial_covariance;
+    p.topLeftCorner<6, 6>() = est::rotate_covariance6(cmd.pose.covariance, world_T_frame->rotation_matrix());
+    p.topRightCorner<6, 9>().setZero();
+    p.bottomLeftCorner<9, 6>().setZero();
+    in.filter->set_pose(cmd.stamp, x, p);
+    for (int i = 0; i < cfg_.num_sensors; ++i) {
+      if (cfg_.sensors[i].instance == k) models_[i].reset();
+    }
+    applied = true;
   }
-  geometry::RigidTransform frame_T_base;
-  frame_T_base.translation = cmd.pose.position;
-  frame_T_base.rotation = cmd.pose.orientation;
-  const geometry::RigidTransform world_T_base = *world_T_frame * frame_T_base;
-  est::StateVector x = est::StateVector::Zero();
-  x.segment<3>(est::kX) = world_T_base.translation;
-  x.segment<3>(est::kRoll) = geometry::rpy_from_quaternion(world_T_base.rotation);
-  // Velocities and accelerations restart at zero with the initial uncertainty;
-  // the pose takes the command's covariance, as robot_localization's set_pose.
-  est::StateMatrix p = cfg_.filter.initial_covariance;
-  p.topLeftCorner<6, 6>() = est::rotate_covariance6(cmd.pose.covariance, world_T_frame->rotation_matrix());
-  p.topRightCorner<6, 9>().setZero();
-  p.bottomLeftCorner<9, 6>().setZero();
-  filter_->set_pose(cmd.stamp, x, p);
-  for (int i = 0; i < cfg_.num_sensors; ++i) models_[i].reset();
-  ++set_pose_count_;
+  if (applied) {
+    ++set_pose_count_;
+  } else {
+    ++set_pose_rejected_;
+  }
 }
 
 void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
-  SensorStats& st = stats_[s.sensor];
+  if (s.kind == est::SensorKind::kImu && s.imu.has_orientation && heading_targets_[s.sensor] != 0) {
+    feed_navsat_heading(s);
+  }
+  for (std::uint32_t m = fused_by_[s.sensor]; m != 0; m &= m - 1) fuse_into(__builtin_ctz(m), s, now);
+}
+
+void FusionCore::fuse_into(int sensor, const est::SensorSample& s, TimeNs now) noexcept {
+  SensorStats& st = stats_[sensor];
   // robot_localization ignores a message older than its topic's previous one.
   if (st.accepted + st.rejected_mahalanobis + st.rejected_stale > 0 && s.stamp < st.last_stamp_ns) {
     ++st.rejected_invalid;
@@ -181,19 +217,18 @@ void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
     st.rate_hz = st.rate_hz == 0.0 ? inst : 0.9 * st.rate_hz + 0.1 * inst;
   }
   st.last_stamp_ns = s.stamp;
-  last_arrival_[s.sensor] = now;
-  if (s.kind == est::SensorKind::kImu && s.imu.has_orientation && heading_targets_[s.sensor] != 0) {
-    feed_navsat_heading(s);
-  }
+  last_arrival_[sensor] = now;
 
+  Instance& in = instances_[cfg_.sensors[sensor].instance < num_instances_ ? cfg_.sensors[sensor].instance : 0];
+  est::Filter& filter = *in.filter;
   est::MeasurementBatch batch;
-  if (models_[s.sensor].convert(s, filter_->state_at(s.stamp), fusion_frames_, &batch) != est::SampleRejection::kNone) {
+  if (models_[sensor].convert(s, filter.state_at(s.stamp), in.frames, &batch) != est::SampleRejection::kNone) {
     ++st.rejected_invalid;
     return;
   }
   bool any_fused = false, any_rejected = false;
   for (int k = 0; k < batch.count; ++k) {
-    const est::ProcessResult r = filter_->process(batch.items[k]);
+    const est::ProcessResult r = filter.process(batch.items[k]);
     lagged_replays_ += r.replayed > 0 ? 1 : 0;
     if (r.stale) {
       ++st.rejected_stale;
@@ -209,6 +244,7 @@ void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
     }
   }
   if (any_fused || (!any_rejected && batch.count == 0)) ++st.accepted;
+  if (any_fused && s.kind == est::SensorKind::kNavSatFix) ++in.fixes_fused;
 }
 
 void FusionCore::tick(TimeNs now, const LoopStats& loop) noexcept {
@@ -238,10 +274,12 @@ void FusionCore::tick(TimeNs now, const LoopStats& loop) noexcept {
     staging_[j + 1] = tmp;
   }
   for (int i = 0; i < n; ++i) fuse(staging_[i], now);
-  if (n == 0) filter_->predict_if_timed_out(now);
+  if (n == 0) {
+    for (int k = 0; k < num_instances_; ++k) instances_[k].filter->predict_if_timed_out(now);
+  }
 
-  const TimeNs timeout = sec_to_ns(cfg_.filter.sensor_timeout_s);
   for (int i = 0; i < cfg_.num_sensors; ++i) {
+    const TimeNs timeout = sec_to_ns(instance_filter(cfg_, cfg_.sensors[i].instance).sensor_timeout_s);
     SensorStats& st = stats_[i];
     const bool timed_out = last_arrival_[i] != 0 && now - last_arrival_[i] > timeout;
     if (timed_out && !st.timed_out) ++st.timeouts;
@@ -250,14 +288,64 @@ void FusionCore::tick(TimeNs now, const LoopStats& loop) noexcept {
   publish_snapshot(now, loop);
 }
 
+void FusionCore::fill_instance(int k, InstanceSnapshot& out) noexcept {
+  const Instance& in = instances_[k];
+  const est::Filter& f = *in.filter;
+  out.stamp_ns = f.has_time() ? f.last_measurement_time() : 0;
+  out.initialized = f.initialized();
+  out.awaiting_fix = in.needs_fix && in.fixes_fused == 0;
+  out.fixes_fused = in.fixes_fused;
+  if (k > 0) {
+    Eigen::Map<est::StateVector>(out.state) = f.state();
+    Eigen::Map<Eigen::Matrix<double, 15, 15, Eigen::RowMajor>>(out.covariance) = f.covariance();
+  }
+  const bool publishable = out.initialized && !out.awaiting_fix;
+  out.has_map_odom = false;
+  if (publishable && in.in_map && local_ >= 0 && local_ != k && instances_[local_].filter->initialized()) {
+    // The local estimate at this instance's stamp (its history has it when
+    // the stamps differ; the two usually fuse the same last sample).
+    const est::StateVector& local = instances_[local_].filter->state_at(out.stamp_ns);
+    const est::StateVector& global = f.state();
+    geometry::RigidTransform map_T_base, odom_T_base;
+    map_T_base.translation = global.segment<3>(est::kX);
+    map_T_base.rotation = geometry::quaternion_from_rpy(global[est::kRoll], global[est::kPitch], global[est::kYaw]);
+    odom_T_base.translation = local.segment<3>(est::kX);
+    odom_T_base.rotation = geometry::quaternion_from_rpy(local[est::kRoll], local[est::kPitch], local[est::kYaw]);
+    const geometry::RigidTransform map_T_odom = map_T_base * odom_T_base.inverse();
+    for (int a = 0; a < 3; ++a) out.map_odom_translation[a] = map_T_odom.translation[a];
+    out.map_odom_rotation[0] = map_T_odom.rotation.x();
+    out.map_odom_rotation[1] = map_T_odom.rotation.y();
+    out.map_odom_rotation[2] = map_T_odom.rotation.z();
+    out.map_odom_rotation[3] = map_T_odom.rotation.w();
+    out.has_map_odom = true;
+  }
+  out.has_filtered_fix = false;
+  if (publishable && in.navsat_sensor >= 0 && models_[in.navsat_sensor].navsat().has_transform()) {
+    const est::StateVector& x = f.state();
+    const est::StateMatrix p = f.covariance();
+    const est::NavSatFixSample fix =
+        models_[in.navsat_sensor].navsat().filtered_fix(x.segment<3>(est::kX), p.topLeftCorner<3, 3>());
+    out.latitude_deg = fix.position.latitude_deg;
+    out.longitude_deg = fix.position.longitude_deg;
+    out.altitude_m = fix.position.altitude_m;
+    Eigen::Map<Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(out.fix_covariance) = fix.covariance;
+    out.has_filtered_fix = true;
+  }
+}
+
 void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
   Snapshot& s = scratch_;
+  const est::Filter& filter = *instances_[0].filter;
   s.tick_time_ns = now;
-  s.stamp_ns = filter_->has_time() ? filter_->last_measurement_time() : now;
+  s.stamp_ns = filter.has_time() ? filter.last_measurement_time() : now;
   s.seq = ++seq_;
-  s.initialized = filter_->initialized();
-  Eigen::Map<est::StateVector>(s.state) = filter_->state();
-  Eigen::Map<Eigen::Matrix<double, 15, 15, Eigen::RowMajor>>(s.covariance) = filter_->covariance();
+  s.initialized = filter.initialized();
+  Eigen::Map<est::StateVector>(s.state) = filter.state();
+  Eigen::Map<Eigen::Matrix<double, 15, 15, Eigen::RowMajor>>(s.covariance) = filter.covariance();
+  s.num_instances = num_instances_;
+  for (int k = 0; k < num_instances_; ++k) fill_instance(k, s.instances[k]);
+  s.instances[0].stamp_ns = s.stamp_ns;
+  s.awaiting_fix = s.instances[0].awaiting_fix;
   s.loop = loop;
   s.loop.measurements_fused = fused_total_;
   s.loop.lagged_replays = lagged_replays_;
@@ -268,7 +356,8 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
   s.num_sensors = cfg_.num_sensors;
   for (int i = 0; i < cfg_.num_sensors; ++i) {
     SensorStats st = stats_[i];
-    const InputCounters& c = input_->counters(i);
+    // A shared input's counters are its first sensor's.
+    const InputCounters& c = input_->counters(sensor_input(cfg_, i));
     st.received = c.received.load(std::memory_order_relaxed);
     st.decode_errors = c.decode_errors.load(std::memory_order_relaxed);
     st.rejected_overflow = c.overflow.load(std::memory_order_relaxed);

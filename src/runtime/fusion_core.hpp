@@ -40,7 +40,10 @@ class FusionCore {
   const SeqLock<Snapshot>& snapshot() const { return snapshot_; }
   // The snapshot of the last tick, for the loop thread itself (no seqlock).
   const Snapshot& last_snapshot() const { return scratch_; }
-  const est::Filter& filter() const { return *filter_; }
+  // The first instance's filter, and instance k's.
+  const est::Filter& filter() const { return *instances_[0].filter; }
+  const est::Filter& filter(int k) const { return *instances_[k].filter; }
+  int num_instances() const { return num_instances_; }
 
   // Not owned; set before the loop starts.
   void set_devices(TickDevices* devices) { devices_ = devices; }
@@ -52,24 +55,42 @@ class FusionCore {
  private:
   explicit FusionCore(const RuntimeConfig& cfg);
   bool build_frames(std::string* error);
+  void build_instances();
   // navsat sensors: lever arms from the frame tree, heading IMUs.
   bool configure_navsat(std::string* error);
   void feed_navsat_heading(const est::SensorSample& s) noexcept;
   void apply_set_pose(const SetPoseCommand& cmd) noexcept;
+  // One sample of an input, into every instance that fuses it.
   void fuse(const est::SensorSample& s, TimeNs now) noexcept;
+  void fuse_into(int sensor, const est::SensorSample& s, TimeNs now) noexcept;
   void publish_snapshot(TimeNs now, const LoopStats& loop) noexcept;
+  void fill_instance(int k, InstanceSnapshot& out) noexcept;
   // The navsat transforms' slots of the diagnostics.
   void fill_navsat(Snapshot& s) noexcept;
 
+  // A filter instance: its EKF, the frames it fuses in, and whether it is
+  // anchored to the map yet.
+  struct Instance {
+    std::unique_ptr<est::Filter> filter;
+    est::FusionFrames frames;
+    bool in_map = false;       // world frame = map_frame
+    bool needs_fix = false;    // in map with a navsat sensor: publishes after its first fix
+    std::int64_t fixes_fused = 0;
+    int navsat_sensor = -1;    // its first navsat sensor: the filtered fix
+  };
+
   RuntimeConfig cfg_;
   geometry::FrameTree frames_;
-  est::FusionFrames fusion_frames_;
+  Instance instances_[kMaxInstances];
+  int num_instances_ = 1;
+  int local_ = -1;  // the first instance in odom, which map instances chain to
   std::unique_ptr<InputRouter> input_;
-  std::unique_ptr<est::Filter> filter_;
+  // Per input: the sensors (bit i) fusing its samples, one per instance at most.
+  std::uint32_t fused_by_[kMaxSensors] = {};
   est::SensorModel models_[kMaxSensors];
   SensorStats stats_[kMaxSensors];
   TimeNs last_arrival_[kMaxSensors] = {};
-  // Per sensor: the navsat sensors (bit j) whose datum heading it gives.
+  // Per input: the navsat sensors (bit j) whose datum heading it gives.
   std::uint32_t heading_targets_[kMaxSensors] = {};
   DeviceSlots slots_;
   int navsat_sensor_[kMaxNavsatSensors] = {};

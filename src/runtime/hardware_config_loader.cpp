@@ -253,27 +253,28 @@ void read_mpu(const Section& s, MpuSection& m) {
 }
 
 // The sensor fed by a driver, checked against what the driver produces.
-int find_source(const Section& root, RuntimeConfig& cfg, SensorSource source, std::string_view source_name,
-                est::SensorKind kind, std::string_view kind_name, bool driver_configured,
+int find_source(const Section& root, RuntimeConfig& cfg, const std::vector<SensorSite>& sites, SensorSource source,
+                std::string_view source_name, est::SensorKind kind, std::string_view kind_name, bool driver_configured,
                 std::string_view driver_section) {
   int found = -1;
-  for (int i = 0; i < cfg.num_sensors; ++i) {
+  for (int i = 0; i < cfg.num_sensors && i < static_cast<int>(sites.size()); ++i) {
     const SensorConfig& sc = cfg.sensors[static_cast<std::size_t>(i)];
-    if (sc.source != source) continue;
-    const std::string key = "sensor[" + std::to_string(i) + "].source";
-    const toml::source_region where = root.find("sensor")->as_array()->get(static_cast<std::size_t>(i))->source();
+    // Another instance's sensor on the same driver shares the first one's ring.
+    if (sc.source != source || sensor_input(cfg, i) != i) continue;
+    const SensorSite& site = sites[static_cast<std::size_t>(i)];
+    const std::string key = site.key + ".source";
     if (found >= 0) {
-      root.diag().add(where, key, "a second sensor with source = " + in_quotes(source_name) + " (also sensor[" +
-                                      std::to_string(found) + "])");
+      root.diag().add(site.where, key, "a second sensor with source = " + in_quotes(source_name) + " (also " +
+                                           sites[static_cast<std::size_t>(found)].key + ")");
       continue;
     }
     if (sc.params.kind != kind) {
-      root.diag().add(where, "sensor[" + std::to_string(i) + "].type",
+      root.diag().add(site.where, site.key + ".type",
                       "source " + in_quotes(source_name) + " produces type " + in_quotes(kind_name));
     }
     if (!driver_configured) {
-      root.diag().add(where, key, "source " + in_quotes(source_name) + " needs a [" + std::string(driver_section) +
-                                      "] section");
+      root.diag().add(site.where, key, "source " + in_quotes(source_name) + " needs a [" + std::string(driver_section) +
+                                           "] section");
     }
     found = i;
   }
@@ -391,7 +392,7 @@ void read_gnss(const Section& s, GnssSection& g) {
 
 }  // namespace
 
-void read_hardware(const Section& root, RuntimeConfig& cfg) {
+void read_hardware(const Section& root, RuntimeConfig& cfg, const std::vector<SensorSite>& sites) {
   HardwareConfig& hw = cfg.hardware;
   Diagnostics& d = root.diag();
   read_backend(Section(section_table(root, "hardware"), "hardware", d), hw, cfg.source);
@@ -419,12 +420,12 @@ void read_hardware(const Section& root, RuntimeConfig& cfg) {
     s.table_error("hardware.backend", std::string("[") + name +
                                           "] needs hardware.backend = \"linux\" (real devices) or \"sim\"");
   }
-  hw.wheel_sensor = find_source(root, cfg, SensorSource::kWheelOdometry, "wheel_odometry", est::SensorKind::kTwist,
+  hw.wheel_sensor = find_source(root, cfg, sites, SensorSource::kWheelOdometry, "wheel_odometry", est::SensorKind::kTwist,
                                 "twist", wheels != nullptr, "wheel_odometry");
-  hw.mpu_sensor = find_source(root, cfg, SensorSource::kMpu, "mpu", est::SensorKind::kImu, "imu", mpu != nullptr, "mpu");
-  hw.vo_sensor = find_source(root, cfg, SensorSource::kStereoVo, "stereo_vo", est::SensorKind::kTwist, "twist",
+  hw.mpu_sensor = find_source(root, cfg, sites, SensorSource::kMpu, "mpu", est::SensorKind::kImu, "imu", mpu != nullptr, "mpu");
+  hw.vo_sensor = find_source(root, cfg, sites, SensorSource::kStereoVo, "stereo_vo", est::SensorKind::kTwist, "twist",
                              vo != nullptr, "vo");
-  hw.gnss_sensor = find_source(root, cfg, SensorSource::kGnss, "gnss", est::SensorKind::kNavSatFix, "navsat",
+  hw.gnss_sensor = find_source(root, cfg, sites, SensorSource::kGnss, "gnss", est::SensorKind::kNavSatFix, "navsat",
                                gnss != nullptr, "gnss");
 }
 

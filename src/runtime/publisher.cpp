@@ -9,6 +9,7 @@
 #include "runtime/device_layout.hpp"
 #include "rtfuse/diagnostics_t.hpp"
 #include "rtfuse/filter_state_t.hpp"
+#include "rtfuse/navsat_fix_t.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/tf_t.hpp"
@@ -73,31 +74,58 @@ struct Output {
   std::int32_t next_seq() noexcept { return static_cast<std::int32_t>(seq++); }
 };
 
-double cov(const Snapshot& s, int row, int col) noexcept { return s.covariance[row * kN + col]; }
+// One instance's estimate in a snapshot: the first's is the snapshot's own
+// fields, the others' their InstanceSnapshot.
+struct Estimate {
+  std::int64_t stamp_ns;
+  bool publishable;  // initialised, and anchored to the map when it must be
+  const double* state;
+  const double* covariance;
+};
 
-void fill_pose(const Snapshot& s, rtfuse::pose_with_covariance_t& p) noexcept {
-  p.pose.position.x = s.state[0];
-  p.pose.position.y = s.state[1];
-  p.pose.position.z = s.state[2];
-  const Eigen::Quaterniond q = geometry::quaternion_from_rpy(s.state[3], s.state[4], s.state[5]);
+Estimate estimate_of(const Snapshot& s, int k) noexcept {
+  if (k == 0) return {s.stamp_ns, s.initialized && !s.awaiting_fix, s.state, s.covariance};
+  const InstanceSnapshot& in = s.instances[k];
+  return {in.stamp_ns, in.initialized && !in.awaiting_fix, in.state, in.covariance};
+}
+
+void fill_pose(const Estimate& e, rtfuse::pose_with_covariance_t& p) noexcept {
+  p.pose.position.x = e.state[0];
+  p.pose.position.y = e.state[1];
+  p.pose.position.z = e.state[2];
+  const Eigen::Quaterniond q = geometry::quaternion_from_rpy(e.state[3], e.state[4], e.state[5]);
   p.pose.orientation.x = q.x();
   p.pose.orientation.y = q.y();
   p.pose.orientation.z = q.z();
   p.pose.orientation.w = q.w();
   for (int r = 0; r < 6; ++r)
-    for (int c = 0; c < 6; ++c) p.covariance[r * 6 + c] = cov(s, r, c);
+    for (int c = 0; c < 6; ++c) p.covariance[r * 6 + c] = e.covariance[r * kN + c];
 }
 
-void fill_twist(const Snapshot& s, rtfuse::twist_with_covariance_t& t) noexcept {
-  t.twist.linear.x = s.state[6];
-  t.twist.linear.y = s.state[7];
-  t.twist.linear.z = s.state[8];
-  t.twist.angular.x = s.state[9];
-  t.twist.angular.y = s.state[10];
-  t.twist.angular.z = s.state[11];
+void fill_twist(const Estimate& e, rtfuse::twist_with_covariance_t& t) noexcept {
+  t.twist.linear.x = e.state[6];
+  t.twist.linear.y = e.state[7];
+  t.twist.linear.z = e.state[8];
+  t.twist.angular.x = e.state[9];
+  t.twist.angular.y = e.state[10];
+  t.twist.angular.z = e.state[11];
   for (int r = 0; r < 6; ++r)
-    for (int c = 0; c < 6; ++c) t.covariance[r * 6 + c] = cov(s, 6 + r, 6 + c);
+    for (int c = 0; c < 6; ++c) t.covariance[r * 6 + c] = e.covariance[(6 + r) * kN + 6 + c];
 }
+
+// A filter instance's outputs.
+struct InstanceOutputs {
+  bool enabled = false;
+  // tf carries map -> odom (a map instance chained to a local one) instead
+  // of world -> base_link.
+  bool tf_map_odom = false;
+  Name odometry_channel, pose_channel, state_channel, fix_channel;
+  Output<rtfuse::odometry_t> odometry;
+  Output<rtfuse::pose_with_covariance_stamped_t> pose;
+  Output<rtfuse::tf_t> tf;
+  Output<rtfuse::filter_state_t> state;
+  Output<rtfuse::navsat_fix_t> fix;
+};
 
 }  // namespace
 
@@ -114,13 +142,13 @@ struct Publisher::Impl {
     return sink.publish(out.channel, out.bytes.data(), n, now) ? 1 : 0;
   }
 
+  int publish_instance(const Snapshot& s, int k, std::uint32_t bits, TimeNs now, MessageSink& sink) noexcept;
+
   PublishConfig cfg;  // owns the channel strings the outputs point into
   int num_sensors = 0;
   int num_devices = 0;
-  Output<rtfuse::odometry_t> odometry;
-  Output<rtfuse::pose_with_covariance_stamped_t> pose;
-  Output<rtfuse::tf_t> tf;
-  Output<rtfuse::filter_state_t> state;
+  int num_instances = 1;
+  InstanceOutputs instances[kMaxInstances];
   Output<rtfuse::diagnostics_t> diagnostics;
   Output<rtfuse::odometry_t> wheel_odometry;  // raw dead reckoning from the encoders
   std::int64_t last_wheel_stamp = -1;
@@ -131,34 +159,65 @@ struct Publisher::Impl {
 
 Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) {
   Impl& m = *impl_;
-  const std::string world = c.world_frame.c_str();
   const std::string base = c.base_link_frame.c_str();
+  m.num_instances = c.num_instances < 1 ? 1 : (c.num_instances > kMaxInstances ? kMaxInstances : c.num_instances);
+  int local = -1;  // the instance map instances chain to (FusionCore's rule)
+  for (int k = 0; k < m.num_instances && local < 0; ++k) {
+    if (instance_world_frame(c, k) != c.map_frame) local = k;
+  }
+  for (int k = 0; k < m.num_instances; ++k) {
+    InstanceOutputs& o = m.instances[k];
+    const InstanceConfig& ic = c.instances[static_cast<std::size_t>(k)];
+    const std::string world = instance_world_frame(c, k).c_str();
+    o.enabled = true;
+    o.tf_map_odom = world == c.map_frame.view() && local >= 0 && local != k;
+    o.odometry_channel = k == 0 ? m.cfg.odometry_channel : ic.odometry_channel;
+    o.pose_channel = k == 0 ? m.cfg.pose_channel : ic.pose_channel;
+    o.state_channel = k == 0 ? m.cfg.state_channel : ic.state_channel;
+    o.fix_channel = ic.filtered_fix_channel;
 
-  m.odometry.channel = m.cfg.odometry_channel.c_str();
-  m.odometry.schedule.set_rate(m.cfg.odometry_rate_hz);
-  m.odometry.msg.header.frame_id = world;
-  m.odometry.msg.child_frame_id = base;
-  m.odometry.finalize();
+    o.odometry.channel = o.odometry_channel.c_str();
+    o.odometry.schedule.set_rate(k == 0 ? m.cfg.odometry_rate_hz : ic.odometry_rate_hz);
+    o.odometry.msg.header.frame_id = world;
+    o.odometry.msg.child_frame_id = base;
+    o.odometry.finalize();
 
-  m.pose.channel = m.cfg.pose_channel.c_str();
-  m.pose.schedule.set_rate(m.cfg.pose_rate_hz);
-  m.pose.msg.header.frame_id = world;
-  m.pose.finalize();
+    o.pose.channel = o.pose_channel.c_str();
+    o.pose.schedule.set_rate(k == 0 ? m.cfg.pose_rate_hz : ic.pose_rate_hz);
+    o.pose.msg.header.frame_id = world;
+    o.pose.finalize();
 
-  m.tf.channel = m.cfg.tf_channel.c_str();
-  m.tf.schedule.set_rate(m.cfg.publish_tf ? m.cfg.tf_rate_hz : 0.0);
-  m.tf.msg.num_transforms = 1;
-  m.tf.msg.transforms.resize(1);
-  m.tf.msg.transforms[0].header.frame_id = world;
-  m.tf.msg.transforms[0].child_frame_id = base;
-  m.tf.msg.transforms[0].transform.rotation.w = 1.0;
-  m.tf.finalize();
+    // Every instance's transform goes on the one tf channel, as every
+    // robot_localization node publishes to /tf.
+    o.tf.channel = m.cfg.tf_channel.c_str();
+    o.tf.schedule.set_rate(m.cfg.publish_tf ? (k == 0 ? m.cfg.tf_rate_hz : ic.tf_rate_hz) : 0.0);
+    o.tf.msg.num_transforms = 1;
+    o.tf.msg.transforms.resize(1);
+    o.tf.msg.transforms[0].header.frame_id = world;
+    o.tf.msg.transforms[0].child_frame_id = o.tf_map_odom ? c.odom_frame.c_str() : base;
+    o.tf.msg.transforms[0].transform.rotation.w = 1.0;
+    o.tf.finalize();
 
-  m.state.channel = m.cfg.state_channel.c_str();
-  m.state.schedule.set_rate(m.cfg.state_rate_hz);
-  m.state.msg.header.frame_id = world;
-  m.state.msg.child_frame_id = base;
-  m.state.finalize();
+    o.state.channel = o.state_channel.c_str();
+    o.state.schedule.set_rate(k == 0 ? m.cfg.state_rate_hz : ic.state_rate_hz);
+    o.state.msg.header.frame_id = world;
+    o.state.msg.child_frame_id = base;
+    o.state.finalize();
+
+    bool has_navsat = false;
+    for (int i = 0; i < c.num_sensors; ++i) {
+      const SensorConfig& sc = c.sensors[static_cast<std::size_t>(i)];
+      has_navsat |= sc.instance == k && sc.params.kind == est::SensorKind::kNavSatFix;
+    }
+    o.fix.channel = o.fix_channel.c_str();
+    o.fix.schedule.set_rate(has_navsat ? ic.filtered_fix_rate_hz : 0.0);
+    o.fix.msg.header.frame_id = world;
+    // As navsat_transform_node reports its filtered fix.
+    o.fix.msg.status = rtfuse::navsat_fix_t::STATUS_GBAS_FIX;
+    o.fix.msg.service = rtfuse::navsat_fix_t::SERVICE_GPS;
+    o.fix.msg.position_covariance_type = rtfuse::navsat_fix_t::COVARIANCE_TYPE_KNOWN;
+    o.fix.finalize();
+  }
 
   m.diagnostics.channel = m.cfg.diagnostics_channel.c_str();
   m.diagnostics.schedule.set_rate(m.cfg.diagnostics_rate_hz);
@@ -168,7 +227,7 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
   m.diagnostics.msg.sensors.resize(static_cast<std::size_t>(n));
   for (int i = 0; i < n; ++i) {
     auto& st = m.diagnostics.msg.sensors[static_cast<std::size_t>(i)];
-    st.name = c.sensors[static_cast<std::size_t>(i)].name.c_str();
+    st.name = qualified_sensor_name(c, i).c_str();
     st.channel = c.sensors[static_cast<std::size_t>(i)].channel.c_str();
     st.level = rtfuse::sensor_status_t::STALE;
   }
@@ -210,15 +269,100 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
 
 Publisher::~Publisher() = default;
 
+int Publisher::Impl::publish_instance(const Snapshot& s, int k, std::uint32_t bits, TimeNs now,
+                                      MessageSink& sink) noexcept {
+  InstanceOutputs& io = instances[k];
+  const Estimate e = estimate_of(s, k);
+  const InstanceSnapshot& in = s.instances[k];
+  int sent = 0;
+  // The estimate's own time, not the publishing time: consumers interpolate
+  // and look up transforms by it, as they would with robot_localization.
+  const std::int64_t utime = ns_to_utime(e.stamp_ns);
+
+  if (bits & kOdometry) {
+    auto& o = io.odometry.msg;
+    o.header.utime = utime;
+    o.header.seq = io.odometry.next_seq();
+    fill_pose(e, o.pose);
+    fill_twist(e, o.twist);
+    sent += emit(io.odometry, now, sink);
+  }
+
+  if (bits & kPose) {
+    auto& o = io.pose.msg;
+    o.header.utime = utime;
+    o.header.seq = io.pose.next_seq();
+    fill_pose(e, o.pose);
+    sent += emit(io.pose, now, sink);
+  }
+
+  if (bits & kTf) {
+    auto& t = io.tf.msg.transforms[0];
+    t.header.utime = utime;
+    t.header.seq = io.tf.next_seq();
+    if (io.tf_map_odom) {
+      t.transform.translation.x = in.map_odom_translation[0];
+      t.transform.translation.y = in.map_odom_translation[1];
+      t.transform.translation.z = in.map_odom_translation[2];
+      t.transform.rotation.x = in.map_odom_rotation[0];
+      t.transform.rotation.y = in.map_odom_rotation[1];
+      t.transform.rotation.z = in.map_odom_rotation[2];
+      t.transform.rotation.w = in.map_odom_rotation[3];
+    } else {
+      t.transform.translation.x = e.state[0];
+      t.transform.translation.y = e.state[1];
+      t.transform.translation.z = e.state[2];
+      const Eigen::Quaterniond q = geometry::quaternion_from_rpy(e.state[3], e.state[4], e.state[5]);
+      t.transform.rotation.x = q.x();
+      t.transform.rotation.y = q.y();
+      t.transform.rotation.z = q.z();
+      t.transform.rotation.w = q.w();
+    }
+    sent += emit(io.tf, now, sink);
+  }
+
+  if (bits & kState) {
+    auto& o = io.state.msg;
+    o.header.utime = utime;
+    o.header.seq = io.state.next_seq();
+    o.initialized = true;
+    for (int i = 0; i < kN; ++i) o.state[i] = e.state[i];
+    for (int i = 0; i < kN * kN; ++i) o.covariance[i] = e.covariance[i];
+    sent += emit(io.state, now, sink);
+  }
+
+  if (bits & kFilteredFix) {
+    auto& o = io.fix.msg;
+    o.header.utime = utime;
+    o.header.seq = io.fix.next_seq();
+    o.latitude = in.latitude_deg;
+    o.longitude = in.longitude_deg;
+    o.altitude = in.altitude_m;
+    for (int i = 0; i < 9; ++i) o.position_covariance[i] = in.fix_covariance[i];
+    sent += emit(io.fix, now, sink);
+  }
+  return sent;
+}
+
 std::int64_t Publisher::encode_failures() const { return impl_->encode_failures; }
 
 std::uint32_t Publisher::schedule(const Snapshot& s, TimeNs now) noexcept {
   Impl& m = *impl_;
   std::uint32_t due = 0;
-  if (s.initialized && m.odometry.schedule.due(now)) due |= kOdometry;
-  if (s.initialized && m.pose.schedule.due(now)) due |= kPose;
-  if (s.initialized && m.tf.schedule.due(now)) due |= kTf;
-  if (s.initialized && m.state.schedule.due(now)) due |= kState;
+  const int instances = s.num_instances < m.num_instances ? s.num_instances : m.num_instances;
+  for (int k = 0; k < instances; ++k) {
+    InstanceOutputs& o = m.instances[k];
+    const InstanceSnapshot& in = s.instances[k];
+    if (!estimate_of(s, k).publishable) continue;
+    std::uint32_t bits = 0;
+    if (o.odometry.schedule.due(now)) bits |= kOdometry;
+    if (o.pose.schedule.due(now)) bits |= kPose;
+    // No map -> odom until both ends exist (nothing bogus before a fix).
+    if ((!o.tf_map_odom || in.has_map_odom) && o.tf.schedule.due(now)) bits |= kTf;
+    if (o.state.schedule.due(now)) bits |= kState;
+    if (in.has_filtered_fix && o.fix.schedule.due(now)) bits |= kFilteredFix;
+    due |= bits << (k * kInstanceShift);
+  }
   const WheelOdometrySnapshot& w = s.wheel_odometry;
   if (w.valid && w.stamp_ns != m.last_wheel_stamp && m.wheel_odometry.schedule.due(now)) {
     m.last_wheel_stamp = w.stamp_ns;
@@ -237,48 +381,9 @@ int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, Message
   int sent = 0;
   // The estimate's own time, not the publishing time: consumers interpolate
   // and look up transforms by it, as they would with robot_localization.
-  const std::int64_t utime = ns_to_utime(s.stamp_ns);
-
-  if (due & kOdometry) {
-    auto& o = m.odometry.msg;
-    o.header.utime = utime;
-    o.header.seq = m.odometry.next_seq();
-    fill_pose(s, o.pose);
-    fill_twist(s, o.twist);
-    sent += m.emit(m.odometry, now, sink);
-  }
-
-  if (due & kPose) {
-    auto& o = m.pose.msg;
-    o.header.utime = utime;
-    o.header.seq = m.pose.next_seq();
-    fill_pose(s, o.pose);
-    sent += m.emit(m.pose, now, sink);
-  }
-
-  if (due & kTf) {
-    auto& t = m.tf.msg.transforms[0];
-    t.header.utime = utime;
-    t.header.seq = m.tf.next_seq();
-    t.transform.translation.x = s.state[0];
-    t.transform.translation.y = s.state[1];
-    t.transform.translation.z = s.state[2];
-    const Eigen::Quaterniond q = geometry::quaternion_from_rpy(s.state[3], s.state[4], s.state[5]);
-    t.transform.rotation.x = q.x();
-    t.transform.rotation.y = q.y();
-    t.transform.rotation.z = q.z();
-    t.transform.rotation.w = q.w();
-    sent += m.emit(m.tf, now, sink);
-  }
-
-  if (due & kState) {
-    auto& o = m.state.msg;
-    o.header.utime = utime;
-    o.header.seq = m.state.next_seq();
-    o.initialized = s.initialized;
-    for (int i = 0; i < kN; ++i) o.state[i] = s.state[i];
-    for (int i = 0; i < kN * kN; ++i) o.covariance[i] = s.covariance[i];
-    sent += m.emit(m.state, now, sink);
+  for (int k = 0; k < m.num_instances; ++k) {
+    const std::uint32_t bits = (due >> (k * kInstanceShift)) & 0xffu & ~(kWheelOdometry | kDiagnostics);
+    if (bits != 0) sent += m.publish_instance(s, k, bits, now, sink);
   }
 
   const WheelOdometrySnapshot& w = s.wheel_odometry;

@@ -1,6 +1,7 @@
 #pragma once
-// Turns the loop's Snapshot into the LCM outputs (odometry, pose, tf, full
-// filter state, diagnostics) at their configured rates.
+// Turns the loop's Snapshot into the LCM outputs (per filter instance:
+// odometry, pose, tf, full filter state, the filtered fix; and diagnostics)
+// at their configured rates.
 //
 // Everything that allocates happens in the constructor: one generated message
 // object per output with its strings already set, and one byte buffer each.
@@ -37,7 +38,13 @@ class Publisher {
     kState = 1u << 3,
     kWheelOdometry = 1u << 4,
     kDiagnostics = 1u << 5,
+    kFilteredFix = 1u << 6,
   };
+  // Instance k's outputs (odometry, pose, tf, state, filtered fix) are the
+  // first instance's bits shifted by k * kInstanceShift; wheel odometry and
+  // diagnostics are the process's, at their own bits.
+  static constexpr int kInstanceShift = 8;
+  static_assert(kMaxInstances * kInstanceShift <= 32, "the due mask is 32 bits");
   // Which outputs are due at `now` for this snapshot (all of them on the
   // first call), consuming their slots. State outputs wait for
   // s.initialized; diagnostics do not. The daemon's loop calls it on tick

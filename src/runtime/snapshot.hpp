@@ -54,13 +54,40 @@ struct WheelOdometrySnapshot {
   double var_vx = 0, var_vyaw = 0;
 };
 
+// One filter instance's estimate and what is derived from it. For the first
+// instance the estimate is Snapshot's own fields (stamp_ns ... covariance)
+// and only map_odom and the filtered fix are filled here.
+struct InstanceSnapshot {
+  std::int64_t stamp_ns = 0;
+  bool initialized = false;
+  // A map instance with a navsat sensor before its first fused fix: its
+  // outputs wait, so nobody sees a map -> odom that nothing anchors.
+  bool awaiting_fix = false;
+  double state[15] = {};
+  double covariance[225] = {};
+  std::int64_t fixes_fused = 0;
+  // map -> odom (a map instance, with a local instance to chain to): this
+  // instance's map -> base_link times the local odom -> base_link inverted,
+  // both at this instance's stamp, as robot_localization's global node does.
+  bool has_map_odom = false;
+  double map_odom_translation[3] = {};
+  double map_odom_rotation[4] = {0.0, 0.0, 0.0, 1.0};  // x y z w
+  // navsat_transform's filtered fix: this instance's position as a fix.
+  bool has_filtered_fix = false;
+  double latitude_deg = 0.0, longitude_deg = 0.0, altitude_m = 0.0;
+  double fix_covariance[9] = {};  // east north up, m², row-major
+};
+
 struct Snapshot {
   std::int64_t tick_time_ns = 0;   // loop clock when the snapshot was taken
   std::int64_t stamp_ns = 0;       // time the estimate is valid at (last measurement)
   std::uint64_t seq = 0;
   bool initialized = false;
+  bool awaiting_fix = false;       // the first instance's (InstanceSnapshot::awaiting_fix)
   double state[15] = {};
   double covariance[225] = {};     // row-major
+  int num_instances = 1;
+  InstanceSnapshot instances[kMaxInstances];
   LoopStats loop;
   std::int64_t unknown_channel_messages = 0;
   std::int64_t set_pose_count = 0;

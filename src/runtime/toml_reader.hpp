@@ -59,6 +59,9 @@ class Section {
   }
   const toml::node* find(std::string_view k) const { return table_ ? table_->get(k) : nullptr; }
   bool has(std::string_view k) const { return find(k) != nullptr; }
+  const std::string& path() const { return path_; }
+  // The table's own place in the file (its header).
+  toml::source_region where() const { return table_ ? table_->source() : toml::source_region{}; }
 
   // Errors about a key (unknown, missing, wrong length) point at the key, or
   // at the table header when the key is absent; errors about a value at it.
