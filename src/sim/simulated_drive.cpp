@@ -2,8 +2,11 @@
 
 #include <algorithm>
 
+#include <cerrno>
 #include <chrono>
 #include <cmath>
+#include <cstdio>
+#include <cstring>
 #include <memory>
 #include <thread>
 
@@ -21,6 +24,44 @@ class NullSink final : public MessageSink {
 };
 
 double wrap(double a) { return std::remainder(a, 2.0 * M_PI); }
+
+// An instance's running error sums.
+struct ErrorSums {
+  double sum_sq = 0.0;
+  double last_ex = 0.0, last_ey = 0.0;
+  double last_map_odom[3] = {};
+  bool has_map_odom = false;
+};
+
+void accumulate(const Snapshot& snap, int k, const TruthState& truth, ErrorSums& sums, InstanceErrors& out) {
+  const InstanceSnapshot& in = snap.instances[k];
+  const bool publishes = k == 0 ? snap.initialized && !snap.awaiting_fix : in.initialized && !in.awaiting_fix;
+  if (!publishes) return;
+  const double* x = k == 0 ? snap.state : in.state;
+  const double ex = x[0] - truth.x, ey = x[1] - truth.y;
+  const double e = std::hypot(ex, ey);
+  if (out.samples > 0) out.max_jump_m = std::max(out.max_jump_m, std::hypot(ex - sums.last_ex, ey - sums.last_ey));
+  sums.last_ex = ex;
+  sums.last_ey = ey;
+  out.max_error_m = std::max(out.max_error_m, e);
+  sums.sum_sq += e * e;
+  ++out.samples;
+  out.final_error_m = e;
+  out.final_yaw_error_rad = std::abs(wrap(x[5] - truth.yaw));
+  if (in.has_map_odom) {
+    if (sums.has_map_odom) {
+      out.max_map_odom_step_m =
+          std::max(out.max_map_odom_step_m, std::hypot(in.map_odom_translation[0] - sums.last_map_odom[0],
+                                                       in.map_odom_translation[1] - sums.last_map_odom[1]));
+    }
+    for (int a = 0; a < 3; ++a) sums.last_map_odom[a] = in.map_odom_translation[a];
+    sums.has_map_odom = true;
+  }
+}
+
+double yaw_of(const double q[4]) {
+  return std::atan2(2.0 * (q[3] * q[2] + q[0] * q[1]), 1.0 - 2.0 * (q[1] * q[1] + q[2] * q[2]));
+}
 
 }  // namespace
 
@@ -60,9 +101,25 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
   LoopStats loop;
   loop.rate_hz = cfg.rate_hz;
   loop.period_ns = period;
-  double sum_sq = 0.0, raw_sum_sq = 0.0;
-  double last_ex = 0.0, last_ey = 0.0;
-  std::int64_t samples = 0, raw_samples = 0;
+  double raw_sum_sq = 0.0;
+  std::int64_t raw_samples = 0;
+  result.num_instances = pipeline->core().num_instances();
+  ErrorSums sums[kMaxInstances];
+  std::FILE* trace = nullptr;
+  if (!options.trace_path.empty()) {
+    trace = std::fopen(options.trace_path.c_str(), "w");
+    if (trace == nullptr) {
+      result.error = options.trace_path + ": cannot write the trace: " + std::strerror(errno);
+      return result;
+    }
+    std::fprintf(trace, "t,truth_x,truth_y,truth_yaw");
+    for (int k = 0; k < result.num_instances; ++k) {
+      const char* name = cfg.instances[static_cast<std::size_t>(k)].name.c_str();
+      std::fprintf(trace, ",%s_x,%s_y,%s_yaw,%s_map_odom_x,%s_map_odom_y,%s_map_odom_yaw", name, name, name, name,
+                   name, name);
+    }
+    std::fprintf(trace, "\n");
+  }
   DriveProgress prog;
   prog.duration_s = duration;
   for (TimeNs t = t0; t <= end; t += period) {
@@ -100,19 +157,28 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
       int size = 0;
       const std::uint8_t* bytes = truth_encoder.encode(truth, t, &size);
       if (tap && size > 0) tap->recorder().record_output(kGroundTruthChannel, bytes, size, t);
+      if (trace != nullptr) {
+        std::fprintf(trace, "%.3f,%.4f,%.4f,%.5f", ns_to_sec(t - t0), truth.x, truth.y, truth.yaw);
+        for (int k = 0; k < result.num_instances; ++k) {
+          const InstanceSnapshot& in = snap.instances[k];
+          const bool publishes = k == 0 ? snap.initialized && !snap.awaiting_fix : in.initialized && !in.awaiting_fix;
+          const double* x = k == 0 ? snap.state : in.state;
+          if (publishes) {
+            std::fprintf(trace, ",%.4f,%.4f,%.5f", x[0], x[1], x[5]);
+          } else {
+            std::fprintf(trace, ",,,");
+          }
+          if (in.has_map_odom) {
+            std::fprintf(trace, ",%.4f,%.4f,%.5f", in.map_odom_translation[0], in.map_odom_translation[1],
+                         yaw_of(in.map_odom_rotation));
+          } else {
+            std::fprintf(trace, ",,,");
+          }
+        }
+        std::fprintf(trace, "\n");
+      }
     }
-    if (snap.initialized) {
-      const double ex = snap.state[0] - truth.x, ey = snap.state[1] - truth.y;
-      const double e = std::hypot(ex, ey);
-      if (samples > 0) result.max_jump_m = std::max(result.max_jump_m, std::hypot(ex - last_ex, ey - last_ey));
-      last_ex = ex;
-      last_ey = ey;
-      result.max_error_m = std::max(result.max_error_m, e);
-      sum_sq += e * e;
-      ++samples;
-      result.final_error_m = e;
-      result.final_yaw_error_rad = std::abs(wrap(snap.state[5] - truth.yaw));
-    }
+    for (int k = 0; k < result.num_instances; ++k) accumulate(snap, k, truth, sums[k], result.instances[k]);
     if (snap.wheel_odometry.valid) {
       const double e = std::hypot(snap.wheel_odometry.x - truth.x, snap.wheel_odometry.y - truth.y);
       raw_sum_sq += e * e;
@@ -126,7 +192,20 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
     }
   }
   result.duration_s = duration;
-  result.rms_error_m = samples > 0 ? std::sqrt(sum_sq / static_cast<double>(samples)) : 0.0;
+  for (int k = 0; k < result.num_instances; ++k) {
+    InstanceErrors& e = result.instances[k];
+    e.rms_error_m = e.samples > 0 ? std::sqrt(sums[k].sum_sq / static_cast<double>(e.samples)) : 0.0;
+  }
+  const InstanceErrors& first = result.instances[0];
+  result.final_error_m = first.final_error_m;
+  result.rms_error_m = first.rms_error_m;
+  result.final_yaw_error_rad = first.final_yaw_error_rad;
+  result.max_error_m = first.max_error_m;
+  result.max_jump_m = first.max_jump_m;
+  if (trace != nullptr && std::fclose(trace) != 0) {
+    result.error = options.trace_path + ": writing the trace: " + std::strerror(errno);
+    return result;
+  }
   result.raw_rms_error_m = raw_samples > 0 ? std::sqrt(raw_sum_sq / static_cast<double>(raw_samples)) : 0.0;
   pipeline->core().snapshot().load(result.final);
   if (tap) {

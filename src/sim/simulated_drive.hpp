@@ -26,8 +26,29 @@ struct DriveOptions {
   // it: the fault-matrix tests inject faults into the robot's devices here
   // (everything runs on this one thread in lockstep).
   std::function<void(TimeNs t, SimulatedRobot& robot)> before_tick;
+  // Every 1/truth_rate_hz: t, the truth and each instance's x y yaw (and a
+  // map instance's map -> odom x y yaw) as one CSV line to this file; empty:
+  // none. For the drive tests' time-based checks (recovery after an outage).
+  std::string trace_path;
   // Called after the loop's tick at t with what it published and the truth.
   std::function<void(TimeNs t, const Snapshot& snapshot, const TruthState& truth)> after_tick;
+};
+
+// One filter instance's position error against ground truth, sampled every
+// tick once it publishes (a map instance: after its first fix). The truth's
+// frame is odom's at the start; a map instance matches it when its datum is
+// the start with the heading east.
+struct InstanceErrors {
+  std::int64_t samples = 0;
+  double final_error_m = 0.0;
+  double rms_error_m = 0.0;
+  double final_yaw_error_rad = 0.0;
+  double max_error_m = 0.0;
+  // The largest change of the position error from one tick to the next: a
+  // jump of the estimate that the robot did not make.
+  double max_jump_m = 0.0;
+  // map -> odom's largest change from one tick to the next (map instances).
+  double max_map_odom_step_m = 0.0;
 };
 
 struct DriveResult {
@@ -46,6 +67,9 @@ struct DriveResult {
   double max_jump_m = 0.0;
   double raw_final_error_m = 0.0;
   double raw_rms_error_m = 0.0;
+  // Every instance's (the first's are the fields above too).
+  int num_instances = 1;
+  InstanceErrors instances[kMaxInstances];
   Snapshot final;
   std::int64_t recording_lost = 0;  // events the recorder had no room for (must be 0)
 };

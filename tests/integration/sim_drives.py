@@ -28,6 +28,18 @@
                     within a 1 m-class receiver's error of the truth, and the
                     recording (the GNSS thread's serial port and clock
                     included) replays every output byte-identically;
+  gnss_drive        config/sim_gnss.toml on its scenario (16 minutes, the local
+                    estimate drifting by metres) with two filter instances,
+                    robot_localization's dual EKF: the global one (wheels,
+                    IMU, GNSS in map) within 0.5 m RMS of the truth and back
+                    within 1 m 10 s after a 60 s outage, multipath fixes
+                    gated and counted; the local one (wheels and IMU in odom)
+                    never jumps; map -> odom moves only by fix corrections;
+                    the recording replays byte-identically, both instances'
+                    outputs included;
+  gnss_live         rtfused live on config/sim_gnss.toml: both instances'
+                    outputs and the filtered fix are published, and the
+                    recording replays byte-identically;
   divergence        a recording whose NMT start frame was altered stops the
                     replay with a report naming the event;
   bad_recordings    another config, a truncated file, a plain log without a
@@ -37,6 +49,7 @@
                     the errno text and the fix.
 """
 import json
+import math
 import os
 import subprocess
 import sys
@@ -398,6 +411,123 @@ def check_gnss_loop(tmp):
     rec = rep["recording"]
     if rec["outputs_compared"] < 10000 or rec["outputs_identical"] != rec["outputs_compared"]:
         sys.exit(f"FAIL: replay reproduced {rec['outputs_identical']} of {rec['outputs_compared']} outputs")
+
+
+def read_trace(path):
+    import csv
+    with open(path) as f:
+        rows = list(csv.DictReader(f))
+
+    def num(v):
+        return float(v) if v != "" else None
+    return [{k: num(v) for k, v in r.items()} for r in rows]
+
+
+def check_gnss_drive(tmp):
+    cfg = os.path.join(SRC, "config", "sim_gnss.toml")
+    log = os.path.join(tmp, "gnss_drive.lcm")
+    trace = os.path.join(tmp, "gnss_drive.csv")
+    r = sim_json(cfg, "-o", log, "--trace", trace)
+    local, glob = r["instances"]["local"], r["instances"]["global"]
+    print(f"gnss_drive: {r['duration_s']:.0f} s\n  local:  {json.dumps(local)}\n  global: {json.dumps(glob)}")
+    failures = []
+    if r["duration_s"] < 900:
+        failures.append(f"the drive lasts {r['duration_s']:.0f} s, not the 15 minutes it must")
+    # The point of the scenario: wheels and IMU alone drift by metres.
+    if local["max_error_m"] < 2.0:
+        failures.append(f"the local estimate drifts only {local['max_error_m']:.2f} m: the scenario tests nothing")
+    # odom -> base_link never jumps: at 200 Hz and 1.5 m/s the robot moves
+    # 7.5 mm a tick; the error may change by a fraction of that.
+    if local["max_jump_m"] > 0.01:
+        failures.append(f"the local estimate jumped {local['max_jump_m']:.3f} m in one tick")
+    rows = read_trace(trace)
+    import tomllib
+    with open(os.path.join(SRC, "config", "scenarios", "gnss_drive.toml"), "rb") as f:
+        [outage] = tomllib.load(f)["gnss"]["outage"]
+    start, end = outage["start_s"], outage["start_s"] + outage["duration_s"]
+
+    def error(q):
+        return math.hypot(q["global_x"] - q["truth_x"], q["global_y"] - q["truth_y"])
+    published = [q for q in rows if q["global_x"] is not None]
+    # With fixes: all but the outage and the 10 s after it (dead reckoning
+    # on slipping wheels is the outage check's business).
+    with_fixes = [error(q) for q in published if not start <= q["t"] <= end + 10.0]
+    rms = math.sqrt(sum(e * e for e in with_fixes) / len(with_fixes))
+    print(f"global RMS {rms:.3f} m while fixes arrive ({glob['rms_error_m']:.3f} m over the whole drive)")
+    if rms > 0.5:
+        failures.append(f"global RMS error {rms:.3f} m > 0.5 m while fixes arrive")
+    at_end = error(min(published, key=lambda q: abs(q["t"] - end)))
+    back = next((q["t"] for q in published if q["t"] >= end and error(q) <= 1.0), None)
+    after = max(error(q) for q in published if end + 10.0 <= q["t"] <= end + 40.0)
+    print(f"outage {start:.0f}-{end:.0f} s: {at_end:.2f} m off when fixes return, within 1 m at "
+          f"{back} s, at most {after:.2f} m from 10 to 40 s after")
+    if at_end < 1.0:
+        failures.append(f"the outage ends only {at_end:.2f} m off: it tests nothing")
+    if back is None or back > end + 10.0:
+        failures.append(f"not back within 1 m 10 s after the outage (at {back} s)")
+    if after > 1.0:
+        failures.append(f"{after:.2f} m off between 10 and 40 s after the outage")
+    # map -> odom: how far each 20 ms change of it moves the robot in map.
+    # It changes when a fix corrects the global instance (5 Hz), by the
+    # correction; between fixes both instances integrate the same samples.
+    steps = []
+    for a, b in zip(published, published[1:]):
+        if a["global_map_odom_x"] is None or b["global_map_odom_x"] is None:
+            continue
+        px, py = b["local_x"], b["local_y"]
+
+        def apply(q):
+            c, s_ = math.cos(q["global_map_odom_yaw"]), math.sin(q["global_map_odom_yaw"])
+            return (q["global_map_odom_x"] + c * px - s_ * py, q["global_map_odom_y"] + s_ * px + c * py)
+        steps.append(math.dist(apply(a), apply(b)))
+    moved = sum(1 for d in steps if d > 0.05)
+    epochs = int(glob["fixes_fused"])
+    print(f"map -> odom: {len(steps)} steps at 50 Hz, {moved} move the robot > 5 cm "
+          f"({epochs} fixes fused), largest {max(steps):.3f} m")
+    if moved > epochs or max(steps) > 2.0:
+        failures.append(f"map -> odom is not continuous: {moved} steps > 5 cm, largest {max(steps):.3f} m")
+    rep = replay_json(log)
+    gps = rep["sensors"]["global/gps0"]
+    navsat = rep["devices"]["navsat global/gps0"]
+    print(f"global/gps0: {json.dumps(gps)}\nnavsat: {json.dumps(navsat)}\nrecording: {json.dumps(rep['recording'])}")
+    gated = gps["rejected_mahalanobis"] + navsat["jumps"]
+    if gated < 3:
+        failures.append(f"only {gated} multipath fixes gated: the scenario's jumps were fused")
+    if rep["sensors"]["wheels"]["received"] != rep["sensors"]["global/wheels"]["received"]:
+        failures.append("the two instances' wheel sensors did not see the same samples")
+    inst = rep["instances"]
+    if set(inst) != {"local", "global"} or inst["global"]["world_frame"] != "map":
+        failures.append(f"the replay's instances: {sorted(inst)}")
+    rec = rep["recording"]
+    if rec["outputs_compared"] < 50000 or rec["outputs_identical"] != rec["outputs_compared"]:
+        failures.append(f"replay reproduced {rec['outputs_identical']} of {rec['outputs_compared']} outputs")
+    if failures:
+        sys.exit("FAIL: " + "; ".join(failures))
+
+
+def check_gnss_live(tmp):
+    """rtfused live (real threads and clock) on config/sim_gnss.toml: both
+    instances publish, the global one map -> odom on the tf channel, and
+    the recording replays byte-identically."""
+    log = os.path.join(tmp, "gnss_live.lcm")
+    p = run([RTFUSED, "--config", os.path.join(SRC, "config", "sim_gnss.toml"), "--duration", "6",
+             "--lcm-url", "memq://", "--record", log])
+    if p.returncode != 0:
+        sys.exit(f"FAIL: rtfused --record: exit {p.returncode}\n{p.stdout}{p.stderr}")
+    counts = {}
+    for ev in lcm_log.read_events(log):
+        counts[ev.channel] = counts.get(ev.channel, 0) + 1
+    print({c: n for c, n in counts.items() if c.startswith("rtfuse/") and not c.startswith("rtfuse/hal")})
+    for channel in ("rtfuse/odometry", "rtfuse/global/odometry", "rtfuse/global/pose", "rtfuse/global/gps/filtered"):
+        if counts.get(channel, 0) < 10:
+            sys.exit(f"FAIL: {counts.get(channel, 0)} messages on {channel} in 6 s of a live run")
+    rep = replay_json(log)
+    rec = rep["recording"]
+    print(json.dumps(rec), json.dumps(rep["instances"]))
+    if rec["outputs_compared"] < 500 or rec["outputs_identical"] != rec["outputs_compared"]:
+        sys.exit(f"FAIL: the live recording replays {rec['outputs_identical']} of {rec['outputs_compared']} outputs")
+    if rep["instances"]["global"]["fixes_fused"] < 20 or "map_odom" not in rep["instances"]["global"]:
+        sys.exit(f"FAIL: the global instance fused {rep['instances']['global']['fixes_fused']} fixes")
 
 
 def check_divergence(tmp):
