@@ -1,6 +1,15 @@
 #!/usr/bin/python3
 """Turn robot_localization EKF node parameters (YAML) into an rtfuse TOML config.
 
+A file with robot_localization's dual-EKF set-up (an EKF in odom, one in map,
+and navsat_transform_node) becomes one config with two filter instances: the
+odom node as the first ([filter], [[sensor]]), the map node as an
+[[instance]] whose navsat_transform output sensor (odomN on odometry/gps)
+becomes a navsat sensor on the receiver's fix with the transform's
+parameters. Each instance takes a short name: --name NODE=NAME, else
+`..._odom` -> local and `..._map` -> global (by world_frame when the node's
+name says neither).
+
 Reads ROS 2 parameter files (`node: {ros__parameters: {...}}`) and ROS 1
 rosparam files (flat, or `node_name: {...}`). Everything robot_localization
 would use and rtfuse understands is carried over under the same name (see
@@ -440,6 +449,175 @@ def parse_static_tf(text):
 
 
 # --------------------------------------------------------------------------
+# dual EKF + navsat_transform
+
+# robot_localization's values for [filter] keys an EKF node leaves out: an
+# rtfuse [[instance]] would otherwise inherit the first instance's.
+RL_FILTER_DEFAULTS = OrderedDict([
+    ("two_d_mode", False),
+    ("process_noise_covariance", [0.05, 0.05, 0.06, 0.03, 0.03, 0.06, 0.025, 0.025,
+                                  0.04, 0.01, 0.01, 0.02, 0.01, 0.01, 0.015]),
+    ("initial_estimate_covariance", [1e-9] * N),
+    ("dynamic_process_noise_covariance", False),
+    ("initial_state", [0.0] * N),
+    ("smooth_lagged_data", False),
+    ("history_length", 0.0),
+    ("gravitational_acceleration", 9.80665),
+])
+FRAME_KEYS = ("odom_frame", "base_link_frame", "map_frame")
+INSTANCE_FILTER_KEYS = ["sensor_timeout"] + list(RL_FILTER_DEFAULTS)
+
+# navsat_transform_node parameters -> the navsat sensor's keys.
+NAVSAT_PARAMS = OrderedDict([
+    ("magnetic_declination_radians", ("magnetic_declination_radians", "float")),
+    ("yaw_offset", ("yaw_offset", "float")),
+    ("zero_altitude", ("zero_altitude", "bool")),
+    ("use_odometry_yaw", ("use_odometry_yaw", "bool")),
+])
+NAVSAT_UNSUPPORTED = {
+    "frequency": "rtfuse converts every fix in the loop, as it arrives",
+    "delay": "no start-up delay: the datum waits for its heading instead",
+    "broadcast_utm_transform": "rtfuse uses a local tangent plane at the datum, not UTM",
+    "broadcast_cartesian_transform": "rtfuse uses a local tangent plane at the datum, not UTM",
+    "broadcast_utm_transform_as_parent_frame": "rtfuse uses a local tangent plane at the datum, not UTM",
+    "broadcast_cartesian_transform_as_parent_frame": "rtfuse uses a local tangent plane at the datum, not UTM",
+    "publish_filtered_gps": "always published (rtfuse/<instance>/gps/filtered)",
+    "transform_timeout": "no tf lookups; the antenna's mounting comes from config",
+    "use_local_cartesian": "rtfuse always uses a local tangent plane",
+    "wait_for_datum": "a datum = [lat, lon, yaw] key is what waits for it",
+    "cartesian_frame_id": "not supported",
+    "use_sim_time": "ROS clock; rtfuse replay runs on the log's time",
+}
+NAVSAT_OUTPUT_TOPIC = "odometry/gps"   # navsat_transform_node's default output
+NAVSAT_FIX_TOPIC = "gps/fix"           # ... and its default input
+
+
+def instance_name(node_name, params, given):
+    """The instance's short name: --name, else from the node's name or frame."""
+    leaf = node_name.strip("/").split("/")[-1] if node_name else ""
+    for key in (node_name.strip("/"), leaf):
+        if key in given:
+            return given[key]
+    if leaf.endswith("_odom"):
+        return "local"
+    if leaf.endswith("_map"):
+        return "global"
+    return "global" if params.get("world_frame") == "map" else "local"
+
+
+def navsat_sensor(res, navsat_params, output_topic, fix_topic):
+    """Replaces the map node's sensor on navsat_transform's output by a navsat
+    sensor on the fix, carrying the transform's parameters."""
+    idx = [i for i, s in enumerate(res.sensors)
+           if s["type"] == "odometry" and s["channel"].strip("/") == output_topic.strip("/")]
+    if not idx:
+        raise ParamError(f"the map EKF fuses no odomN on navsat_transform's output "
+                         f"'{output_topic}' (give --navsat-output TOPIC if it is remapped)")
+    old = res.sensors[idx[0]]
+    s = OrderedDict(name=old["name"], type="navsat", channel=fix_topic)
+    mask = old["config"]
+    dropped = [STATE[i] for i in range(N) if mask[i] and i > 2]
+    s["config"] = [mask[i] and i <= 2 for i in range(N)]
+    if dropped:
+        res.notes.append(f"{old['name']}: {' '.join(dropped)} cleared: a fix is a position "
+                         "(navsat_transform's odometry/gps carries nothing else)")
+    if not any(s["config"]):
+        raise ParamError(f"{old['name']}_config fuses none of x y z: the fix would be ignored")
+    for k in ("queue_size", "pose_rejection_threshold"):
+        if k in old:
+            s[k] = old[k]
+    for k in ("differential", "relative"):
+        if old.get(k):
+            res.notes.append(f"{old['name']}_{k} dropped: a navsat sensor is absolute")
+    for key, (out, kind) in NAVSAT_PARAMS.items():
+        if key in navsat_params:
+            s[out] = CONVERT[kind](key, navsat_params[key])
+    datum = navsat_params.get("datum")
+    if navsat_params.get("wait_for_datum") and datum is not None:
+        if not isinstance(datum, list) or len(datum) < 3 or not all(_is_num(v) for v in datum[:3]):
+            raise ParamError(f"datum: expected [latitude, longitude, yaw, ...], got {datum!r}")
+        lat, lon, yaw = (float(v) for v in datum[:3])
+        if not (-90 <= lat <= 90 and -180 <= lon <= 180):
+            raise ParamError(f"datum: latitude {lat} / longitude {lon} out of range")
+        s["datum"] = [lat, lon, yaw]
+        s.pop("use_odometry_yaw", None)
+    elif not s.get("use_odometry_yaw"):
+        s.pop("use_odometry_yaw", None)  # false is the default; the IMU is the source
+        # Its imu input: the map EKF's IMU (one fusing yaw first).
+        imus = sorted((x for x in res.sensors if x["type"] == "imu"), key=lambda x: not x["config"][5])
+        if not imus:
+            raise ParamError("navsat_transform takes its heading from an IMU, but the map EKF "
+                             "has no IMU sensor: set use_odometry_yaw or a datum")
+        s["heading_imu"] = imus[0]["name"]
+        res.notes.append(f"{old['name']}: the datum's heading comes from {imus[0]['name']} "
+                         f"({imus[0]['channel']}), as navsat_transform's imu input")
+    res.notes.append(f"{old['name']}: navsat_transform's output ({old['channel']}) became a navsat "
+                     f"sensor on the fix ({fix_topic}); give it frame = <antenna frame> and a "
+                     "static transform for the antenna's lever arm")
+    for key, value in navsat_params.items():
+        if key in NAVSAT_PARAMS or key == "datum":
+            continue
+        if key in NAVSAT_UNSUPPORTED:
+            res.not_carried.append((key, value, NAVSAT_UNSUPPORTED[key]))
+        else:
+            res.unknown.append((key, value))
+    res.sensors[idx[0]] = s
+
+
+def convert_dual(local, glob, navsat, names, output_topic, fix_topic):
+    """(Result of the first instance, Result of the [[instance]], its name)."""
+    (lname, lparams, _), (gname, gparams, _) = local, glob
+    lres, gres = convert_params(lparams), convert_params(gparams)
+    lres.filter["name"] = instance_name(lname, lparams, names)
+    gshort = instance_name(gname, gparams, names)
+    if gshort == lres.filter["name"]:
+        raise ParamError(f"both EKF nodes would be named '{gshort}': give --name NODE=NAME")
+    for k in FRAME_KEYS:
+        if k in gres.filter and gres.filter[k] != lres.filter.get(k, gres.filter[k]):
+            raise ParamError(f"{k}: '{gres.filter[k]}' in {display(gname)} but "
+                             f"'{lres.filter[k]}' in {display(lname)}: rtfuse has one set of frames")
+        if k in gres.filter:
+            lres.filter.setdefault(k, gres.filter[k])
+    lf, gf = lres.filter["frequency"], gres.filter["frequency"]
+    if gf != lf:
+        lres.filter["frequency"] = max(lf, gf)
+        lres.notes.append(f"frequency: {lf} Hz ({display(lname)}) and {gf} Hz ({display(gname)}): "
+                          f"one loop runs both instances at {max(lf, gf)} Hz")
+    # robot_localization's sensor_timeout defaults to 1 / the node's own
+    # frequency, which the shared loop rate may no longer be.
+    if "sensor_timeout" not in lres.filter and lres.filter["frequency"] != lf:
+        lres.filter["sensor_timeout"] = 1.0 / lf
+        lres.defaults.append(f"sensor_timeout = 1/{lf} Hz ({display(lname)}'s own frequency)")
+    inst = OrderedDict(name=gshort, world_frame=gres.filter.get("world_frame", "odom"))
+    if "sensor_timeout" not in gres.filter and ("sensor_timeout" in lres.filter or lres.filter["frequency"] != gf):
+        gres.filter["sensor_timeout"] = 1.0 / gf
+    for k, v in RL_FILTER_DEFAULTS.items():
+        if k not in gres.filter and k in lres.filter:
+            gres.filter[k] = v
+            gres.defaults.append(f"{k} in {gshort} (robot_localization's default; it would "
+                                 f"inherit {lres.filter['name']}'s)")
+    for k in INSTANCE_FILTER_KEYS:
+        if k in gres.filter:
+            inst[k] = gres.filter[k]
+    if navsat is not None:
+        navsat_sensor(gres, navsat[1], output_topic, fix_topic)
+    gres.instance = inst
+    return lres, gres
+
+
+def render_instance(gres):
+    L = ["", "[[instance]]"]
+    for k, v in gres.instance.items():
+        L.append(toml_kv(k, v))
+    for s in gres.sensors:
+        L.append("")
+        L.append("[[instance.sensor]]")
+        for k, v in s.items():
+            L.append(toml_kv(k, v))
+    return L
+
+
+# --------------------------------------------------------------------------
 # TOML output (written by hand: Debian 12's Python has a TOML reader only)
 
 def toml_str(s):
@@ -510,7 +688,7 @@ def comment_value(v):
     return text if len(text) <= 60 else text[:57] + "..."
 
 
-def render(res, source, node_name, style):
+def render(res, source, node_name, style, extra=None):
     L = []
     L.append("# rtfuse configuration generated by tools/rl_params_to_toml.py")
     L.append("# from robot_localization parameters: " + source.replace("\n", " "))
@@ -530,6 +708,8 @@ def render(res, source, node_name, style):
             L.append(f"#   {k} = {comment_value(v)}")
     L.append("")
     L.append("[filter]")
+    if "name" in res.filter:
+        res.filter.move_to_end("name", last=False)
     for k, v in res.filter.items():
         L.append(toml_kv(k, v))
     if res.publish:
@@ -542,6 +722,17 @@ def render(res, source, node_name, style):
         L.append("[[sensor]]")
         for k, v in s.items():
             L.append(toml_kv(k, v))
+    if extra is not None:
+        if extra.not_carried or extra.unknown:
+            at = next(i for i, line in enumerate(L) if line == "")
+            lines = [f"#   {k} = {comment_value(v)}  ({why})" for k, v, why in extra.not_carried]
+            lines += [f"#   {k} = {comment_value(v)}  (not a robot_localization parameter)" for k, v in extra.unknown]
+            L[at:at] = [f"# not carried over from {extra.instance['name']}'s nodes:"] + lines
+        for d in extra.defaults:
+            L.insert(4, f"# default made explicit: {d}")
+        for n in extra.notes:
+            L.insert(4, f"# adjusted: {n}")
+        L += render_instance(extra)
     for tf in res.static_tfs:
         L.append("")
         L.append("[[static_transform]]")
@@ -587,7 +778,24 @@ def _loader():
     return yaml, Loader
 
 
-def convert_file(yaml_path, node=None, static_tfs=(), err=sys.stderr):
+def dual_nodes(nodes):
+    """(odom EKF, map EKF, navsat node or None) when the file holds
+    robot_localization's dual-EKF set-up, else None."""
+    ekf = [n for n in nodes if is_ekf(n[1])]
+    if len(ekf) != 2:
+        return None
+    in_map = [n for n in ekf if n[1].get("world_frame") == "map"]
+    if len(in_map) != 1:
+        return None
+    local = next(n for n in ekf if n is not in_map[0])
+    navsat = [n for n in nodes if set(n[1]) & NAVSAT_KEYS]
+    if len(navsat) > 1:
+        raise ParamError("several navsat_transform nodes: " + ", ".join(display(n[0]) for n in navsat))
+    return local, in_map[0], (navsat[0] if navsat else None)
+
+
+def convert_file(yaml_path, node=None, static_tfs=(), err=sys.stderr, names=None,
+                 navsat_output=NAVSAT_OUTPUT_TOPIC, fix_topic=NAVSAT_FIX_TOPIC):
     """Returns (toml_text, Result, node_name)."""
     yaml, Loader = _loader()
     path = Path(yaml_path)
@@ -606,8 +814,24 @@ def convert_file(yaml_path, node=None, static_tfs=(), err=sys.stderr):
             raise ParamError(f"{path}: expected a YAML mapping, got {type(d).__name__}")
         doc.update(d)
     try:
-        name, params, style = select_node(find_nodes(doc), node)
+        nodes = find_nodes(doc)
+        dual = dual_nodes(nodes) if node is None else None
+        if dual is not None:
+            local, glob, navsat = dual
+            res, gres = convert_dual(local, glob, navsat, names or {}, navsat_output, fix_topic)
+            res.static_tfs = [parse_static_tf(t) for t in static_tfs]
+            name = local[0]
+            report(res, local[0], err)
+            report(gres, glob[0], err)
+            out = render(res, str(path), f"{display(local[0])}, {display(glob[0])}"
+                         + (f" and {display(navsat[0])}" if navsat else ""), local[2], gres)
+            res.instances = [res.filter["name"], gres.instance["name"]]
+            res.sensors = res.sensors + gres.sensors
+            return out, res, name
+        name, params, style = select_node(nodes, node)
         res = convert_params(params)
+        if names:
+            res.filter["name"] = instance_name(name, params, names)
         res.static_tfs = [parse_static_tf(t) for t in static_tfs]
     except ParamError as e:
         raise ParamError(f"{path}: {e}") from None
@@ -632,9 +856,26 @@ def main(argv=None):
                    help="a static transform in tf2 static_transform_publisher's "
                         "argument order (repeatable); 'x y z qx qy qz qw parent "
                         "child' is accepted too")
+    p.add_argument("--name", metavar="NODE=NAME", action="append", default=[],
+                   help="the filter instance's short name for an EKF node (repeatable; default: "
+                        "..._odom -> local, ..._map -> global)")
+    p.add_argument("--navsat-output", metavar="TOPIC", default=NAVSAT_OUTPUT_TOPIC,
+                   help="navsat_transform's output topic as the map EKF subscribes it "
+                        f"(default {NAVSAT_OUTPUT_TOPIC})")
+    p.add_argument("--fix-topic", metavar="TOPIC", default=NAVSAT_FIX_TOPIC,
+                   help=f"the receiver's NavSatFix topic (default {NAVSAT_FIX_TOPIC})")
     args = p.parse_args(argv)
+    names = {}
+    for item in args.name:
+        node_name, sep, short = item.partition("=")
+        if not sep or not node_name or not re.fullmatch(r"[a-z0-9_]{1,15}", short):
+            print(f"rl_params_to_toml: error: --name {item!r}: expected NODE=NAME, NAME 1 to 15 "
+                  "characters of a-z, 0-9 and _", file=sys.stderr)
+            return EXIT_ERROR
+        names[node_name.strip("/")] = short
     try:
-        text, res, name = convert_file(args.params, args.node, args.static_tf)
+        text, res, name = convert_file(args.params, args.node, args.static_tf, names=names,
+                                       navsat_output=args.navsat_output, fix_topic=args.fix_topic)
     except ParamError as e:
         print(f"rl_params_to_toml: error: {e}", file=sys.stderr)
         return EXIT_ERROR
@@ -647,7 +888,9 @@ def main(argv=None):
             print(f"rl_params_to_toml: error: cannot write {args.output}: "
                   f"{e.strerror}", file=sys.stderr)
             return EXIT_ERROR
-        print(f"wrote {args.output}: node {display(name)}, "
+        instances = getattr(res, "instances", None)
+        what = (f"instances {' and '.join(instances)}" if instances else f"node {display(name)}")
+        print(f"wrote {args.output}: {what}, "
               f"{len(res.sensors)} sensor(s), "
               f"{len(res.static_tfs)} static transform(s)", file=sys.stderr)
     return EXIT_OK

@@ -11,6 +11,8 @@ packages=(
   libgtest-dev libgmock-dev libbenchmark-dev
   default-jdk-headless
   python3 python3-rosbag python3-yaml python3-matplotlib
+  # ROS message classes for the bags the integration tests write (test only)
+  python3-sensor-msgs python3-nav-msgs
   iproute2 util-linux
   linux-libc-dev libgpiod-dev
   # the stereo PNG writer of the snapshot tool (src/apps/stereo_png.cpp)

@@ -250,11 +250,25 @@ class SeveralNodes(ToolCase):
       yaw_offset: 0
     """
 
-    def test_without_node_is_an_error(self):
+    def test_dual_set_up_without_a_heading_is_an_error(self):
+        # Without --node the two EKFs become two instances; navsat_transform
+        # then needs a heading the map EKF does not have.
         self.run_tool(self.YAML, expect=2)
+        self.assertIn("no IMU sensor: set use_odometry_yaw or a datum", self.stderr)
+
+    def test_three_ekf_nodes_need_node(self):
+        text = self.YAML.replace("    navsat_transform:", """\
+    ekf_third:
+      frequency: 30
+      odom0: odometry/wheel
+      odom0_config: [false, false, false, false, false, false,
+                     true, false, false, false, false, false,
+                     false, false, false]
+    navsat_transform:""")
+        self.run_tool(text, expect=2)
         self.assertIn("--node", self.stderr)
         self.assertIn("ekf_se_odom", self.stderr)
-        self.assertIn("ekf_se_map", self.stderr)
+        self.assertIn("ekf_third", self.stderr)
         self.assertNotIn("navsat_transform", self.stderr)
 
     def test_with_node(self):
@@ -294,6 +308,133 @@ class SeveralNodes(ToolCase):
                            false, false, false]
         """)
         self.assertEqual(cfg["filter"]["frequency"], 30.0)
+
+
+# robot_localization's dual_ekf_navsat_example parameters (ROS 2), trimmed.
+DUAL_YAML = """\
+ekf_filter_node_odom:
+  ros__parameters:
+    frequency: 30.0
+    two_d_mode: true
+    publish_tf: true
+    map_frame: map
+    odom_frame: odom
+    base_link_frame: base_link
+    world_frame: odom
+    odom0: odometry/wheel
+    odom0_config: [false, false, false, false, false, false,
+                   true, true, false, false, false, true,
+                   false, false, false]
+    odom0_queue_size: 10
+    imu0: imu/data
+    imu0_config: [false, false, false, false, false, true,
+                  false, false, false, false, false, true,
+                  false, false, false]
+    imu0_remove_gravitational_acceleration: true
+    process_noise_covariance: PROCESS_NOISE
+    use_control: false
+ekf_filter_node_map:
+  ros__parameters:
+    frequency: 50.0
+    two_d_mode: true
+    map_frame: map
+    odom_frame: odom
+    base_link_frame: base_link
+    world_frame: map
+    odom0: odometry/wheel
+    odom0_config: [false, false, false, false, false, false,
+                   true, true, false, false, false, true,
+                   false, false, false]
+    odom1: odometry/gps
+    odom1_config: [true, true, false, false, false, false,
+                   false, false, false, false, false, false,
+                   false, false, false]
+    odom1_queue_size: 10
+    odom1_pose_rejection_threshold: 5.0
+    imu0: imu/data
+    imu0_config: [false, false, false, false, false, true,
+                  false, false, false, false, false, true,
+                  false, false, false]
+navsat_transform:
+  ros__parameters:
+    frequency: 30.0
+    delay: 3.0
+    magnetic_declination_radians: 0.0429351
+    yaw_offset: 1.570796327
+    zero_altitude: true
+    broadcast_cartesian_transform: true
+    publish_filtered_gps: true
+    use_odometry_yaw: false
+    wait_for_datum: false
+""".replace("PROCESS_NOISE", "[" + ", ".join(
+    str(0.5 if i == j else 0.0) if i == j else "0.0" for i in range(15) for j in range(15)) + "]")
+
+
+class DualEkf(ToolCase):
+    def test_two_instances(self):
+        cfg = self.run_tool(DUAL_YAML)
+        f = cfg["filter"]
+        self.assertEqual(f["name"], "local")
+        self.assertEqual(f["world_frame"], "odom")
+        # One loop runs both: the faster node's rate.
+        self.assertEqual(f["frequency"], 50.0)
+        self.assertIn("one loop runs both instances at 50.0 Hz", self.stderr)
+        self.assertEqual([s["name"] for s in cfg["sensor"]], ["odom0", "imu0"])
+        [inst] = cfg["instance"]
+        self.assertEqual(inst["name"], "global")
+        self.assertEqual(inst["world_frame"], "map")
+        self.assertTrue(inst["two_d_mode"])
+        # robot_localization's default, not the local node's value inherited.
+        self.assertEqual(f["process_noise_covariance"][0], 0.5)
+        self.assertEqual(inst["process_noise_covariance"][0], 0.05)
+        # Each node's own default timeout, 1 / its own frequency.
+        self.assertAlmostEqual(f["sensor_timeout"], 1.0 / 30.0)
+        self.assertAlmostEqual(inst["sensor_timeout"], 1.0 / 50.0)
+        names = [s["name"] for s in inst["sensor"]]
+        self.assertEqual(names, ["odom0", "odom1", "imu0"])
+        gps = inst["sensor"][1]
+        self.assertEqual(gps["type"], "navsat")
+        self.assertEqual(gps["channel"], "gps/fix")
+        self.assertEqual(gps["config"], mask("x", "y"))
+        self.assertEqual(gps["pose_rejection_threshold"], 5.0)
+        self.assertAlmostEqual(gps["magnetic_declination_radians"], 0.0429351)
+        self.assertAlmostEqual(gps["yaw_offset"], 1.570796327)
+        self.assertTrue(gps["zero_altitude"])
+        self.assertEqual(gps["heading_imu"], "imu0")
+        self.assertNotIn("use_odometry_yaw", gps)
+        self.assertIn("broadcast_cartesian_transform", self.stderr)
+        self.assertIn("instances local and global", self.stderr)
+
+    def test_names_from_the_command_line(self):
+        cfg = self.run_tool(DUAL_YAML, "--name", "ekf_filter_node_odom=odom_ekf",
+                            "--name", "ekf_filter_node_map=map_ekf")
+        self.assertEqual(cfg["filter"]["name"], "odom_ekf")
+        self.assertEqual(cfg["instance"][0]["name"], "map_ekf")
+        self.run_tool(DUAL_YAML, "--name", "ekf_filter_node_map=Map!", expect=2)
+        self.assertIn("expected NODE=NAME", self.stderr)
+
+    def test_a_configured_datum(self):
+        text = DUAL_YAML.replace("wait_for_datum: false",
+                                 "wait_for_datum: true\n    datum: [55.944904, -3.186693, 0.0]")
+        gps = self.run_tool(text)["instance"][0]["sensor"][1]
+        self.assertEqual(gps["datum"], [55.944904, -3.186693, 0.0])
+        self.assertNotIn("heading_imu", gps)
+        bad = DUAL_YAML.replace("wait_for_datum: false", "wait_for_datum: true\n    datum: [95.0, 0.0, 0.0]")
+        self.run_tool(bad, expect=2)
+        self.assertIn("datum: latitude 95.0", self.stderr)
+
+    def test_a_remapped_navsat_output_must_be_named(self):
+        text = DUAL_YAML.replace("odom1: odometry/gps", "odom1: gps/odometry")
+        self.run_tool(text, expect=2)
+        self.assertIn("--navsat-output", self.stderr)
+        cfg = self.run_tool(text, "--navsat-output", "gps/odometry", "--fix-topic", "fix")
+        self.assertEqual(cfg["instance"][0]["sensor"][1]["channel"], "fix")
+
+    def test_disagreeing_frames_are_an_error(self):
+        text = DUAL_YAML.replace("    base_link_frame: base_link\n    world_frame: map",
+                                 "    base_link_frame: base_footprint\n    world_frame: map")
+        self.run_tool(text, expect=2)
+        self.assertIn("base_link_frame: 'base_footprint'", self.stderr)
 
 
 class StaticTf(ToolCase):
