@@ -200,6 +200,9 @@ int main(int argc, char** argv) {
   double err_sq_sum = 0.0;
   long err_samples = 0;
   double last_error = NAN;
+  double instance_error[rtfuse::kMaxInstances] = {};
+  double instance_sq_sum[rtfuse::kMaxInstances] = {};
+  long instance_samples[rtfuse::kMaxInstances] = {};
   rtfuse::Snapshot s;
   bool recording_failure_said = false;
 
@@ -238,6 +241,16 @@ int main(int argc, char** argv) {
       last_error = std::hypot(s.state[0] - tx, s.state[1] - ty);
       err_sq_sum += last_error * last_error;
       ++err_samples;
+      // Every further instance once it publishes (a map instance: after
+      // its first fix), against the same truth at its own stamp.
+      for (int k = 1; robot && k < s.num_instances; ++k) {
+        const rtfuse::InstanceSnapshot& in = s.instances[k];
+        if (!in.initialized || in.awaiting_fix) continue;
+        const rtfuse::sim::TruthState truth = robot->truth_at(in.stamp_ns);
+        instance_error[k] = std::hypot(in.state[0] - truth.x, in.state[1] - truth.y);
+        instance_sq_sum[k] += instance_error[k] * instance_error[k];
+        ++instance_samples[k];
+      }
     }
     if (quiet || now < next_status) continue;
     next_status = now + (tty ? 250'000'000 : 5'000'000'000);
@@ -281,6 +294,13 @@ int main(int argc, char** argv) {
   if ((sim || robot) && err_samples > 0) {
     std::printf("rtfused: position error against ground truth: final %.3f m, RMS %.3f m over %ld samples\n",
                 last_error, std::sqrt(err_sq_sum / err_samples), err_samples);
+  }
+  for (int k = 1; k < s.num_instances; ++k) {
+    if (instance_samples[k] == 0) continue;
+    std::printf("rtfused: instance %s: position error against ground truth: final %.3f m, RMS %.3f m over %ld "
+                "samples\n",
+                cfg.instances[static_cast<std::size_t>(k)].name.c_str(), instance_error[k],
+                std::sqrt(instance_sq_sum[k] / static_cast<double>(instance_samples[k])), instance_samples[k]);
   }
   if (!record_path.empty()) {
     if (!recorded) {
