@@ -1,7 +1,8 @@
 // The running daemon's input path: config/sim.toml's simulated robot with
 // every sensor (encoders over CAN, the MPU over I2C, the stereo camera and
 // its visual odometry) and the loop, publisher and LCM threads of rtfused,
-// plus one LCM sensor of each type and set_pose accepted. Each input is one
+// plus one LCM sensor of each type, a global filter instance in map fusing
+// three of them again (shared inputs, map -> odom) and set_pose accepted. Each input is one
 // message, published on memq:// to the daemon's own LCM node while it runs:
 // the first byte picks the channel (odometry, pose, twist, IMU, set_pose,
 // navsat fix, as in sample_decoder_fuzz.cpp, whose seeds serve here), the
@@ -66,6 +67,34 @@ type = "navsat"
 channel = "fuzz/navsat"
 config = [true, true, true, false, false, false, false, false, false, false, false, false, false, false, false]
 heading_imu = "fuzz_imu"
+)";
+
+// A global instance in map (robot_localization's dual EKF) on the same
+// inputs: the shared rings fused twice, map -> odom from both estimates.
+constexpr const char* kGlobalInstance = R"(
+[[instance]]
+name = "global"
+world_frame = "map"
+
+[[instance.sensor]]
+name = "fuzz_odometry"
+type = "odometry"
+channel = "fuzz/odometry"
+config = [false, false, false, false, false, false, true, true, false, false, false, true, false, false, false]
+
+[[instance.sensor]]
+name = "fuzz_imu"
+type = "imu"
+channel = "fuzz/imu"
+config = [false, false, false, true, true, true, false, false, false, true, true, true, false, false, false]
+
+[[instance.sensor]]
+name = "fuzz_navsat"
+type = "navsat"
+channel = "fuzz/navsat"
+config = [true, true, false, false, false, false, false, false, false, false, false, false, false, false, false]
+heading_imu = "fuzz_imu"
+pose_rejection_threshold = 5.0
 )";
 
 struct Daemon {
@@ -160,6 +189,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   if (at == std::string::npos) fail(path + " has no '" + off + "' to turn on");
   text.replace(at, off.size(), "accept_set_pose = true");
   text += kFuzzSensors;
+  text += kGlobalInstance;
   rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(text, path);
   if (!loaded.config) fail(loaded.errors.empty() ? "config" : loaded.errors.front().to_string());
   g_daemon = new Daemon;
@@ -177,7 +207,9 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
     if (!d.runtime->lcm().subscribe(channel, count_input, &d)) fail("subscribe");
   }
   if (!d.runtime->lcm().subscribe(cfg.publish.odometry_channel.c_str(), check_odometry, &d) ||
-      !d.runtime->lcm().subscribe(cfg.publish.pose_channel.c_str(), check_pose, &d)) {
+      !d.runtime->lcm().subscribe(cfg.publish.pose_channel.c_str(), check_pose, &d) ||
+      !d.runtime->lcm().subscribe(cfg.instances[1].odometry_channel.c_str(), check_odometry, &d) ||
+      !d.runtime->lcm().subscribe(cfg.instances[1].pose_channel.c_str(), check_pose, &d)) {
     fail("subscribe");
   }
   std::string warnings;
