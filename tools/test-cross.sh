@@ -58,5 +58,8 @@ cd "$dir"
 #   integration_cross_arch replays a drive with frames across the two
 #   architectures, every rectified pair compared, which is what this stage
 #   is for.
+# - the quarter-hour GNSS drive (integration_gnss_drive: its targets are
+#   the estimator's, the same bits on both architectures): integration_cross_arch
+#   crosses the same config on the 3-minute GNSS loop.
 ctest --output-on-failure -j2 -L 'unit|integration|system|package' \
-  -E '^(HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack|SimCamera\.LockstepDriveRectifiesEveryFrameAtTheConfiguredRate|SimCamera\.RecordedFramesReplayThroughTheDriver)$' "$@"
+  -E '^(HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack|SimCamera\.LockstepDriveRectifiesEveryFrameAtTheConfiguredRate|SimCamera\.RecordedFramesReplayThroughTheDriver|integration_gnss_drive)$' "$@"

@@ -209,12 +209,15 @@ def check_cross_arch(tmp):
     # The demo drive (200 s, encoders and IMU), then with frames: the product
     # config (encoders, IMU, stereo camera and its visual odometry fused) on
     # the 20 s straight, every estimate output and every rectified pair the
-    # same on both architectures.
-    for what, cfg, least in (("demo", write_config(tmp, "demo"), 10000),
-                             ("with frames", product_config(tmp, "straight"), 1000)):
+    # same on both architectures; then the dual EKF with the GNSS receiver
+    # (geodesy, the navsat transform, map -> odom) on the 3-minute GNSS loop.
+    gnss = ["-s", os.path.join(SRC, "config", "scenarios", "gnss_loop.toml")]
+    for what, cfg, least, extra in (("demo", write_config(tmp, "demo"), 10000, []),
+                                    ("with frames", product_config(tmp, "straight"), 1000, []),
+                                    ("gnss", os.path.join(SRC, "config", "sim_gnss.toml"), 20000, gnss)):
         for name, sim, rep in (("this->other", SIM, other_replay), ("other->this", other_sim, REPLAY)):
             log = os.path.join(tmp, f"{what.replace(' ', '_')}_{name.replace('->', '_')}.lcm")
-            p = run([sim, "-q", "-c", cfg, "-o", log])
+            p = run([sim, "-q", "-c", cfg, "-o", log] + extra)
             if p.returncode != 0:
                 sys.exit(f"FAIL: {name} {what}: {sim}: exit {p.returncode}\n{p.stdout}{p.stderr}")
             p = run([rep, "-q", "-l", log])
