@@ -8,7 +8,7 @@
 #   --jobs J      harnesses run side by side (default: the CPU count);
 #   --regression  the test command's short run: each harness replays its
 #                 seeds and regression inputs and fuzzes for
-#                 RTFUSE_FUZZ_SECONDS (default 20) seconds.
+#                 RTFUSE_FUZZ_SECONDS (default 10) seconds.
 # Seeds (build/asan/seeds/<harness>, remade every run): the repository's own
 # configs and calibration file, the KITTI calib.txt and poses.txt of the
 # shared data, what tests/fuzz/make_seeds encodes (a HAL recording, its
@@ -27,7 +27,7 @@ while (($#)); do
     --time) time=$2; shift 2 ;;
     --runs) runs=$2; shift 2 ;;
     --jobs) jobs=$2; shift 2 ;;
-    --regression) regression=1; time=${RTFUSE_FUZZ_SECONDS:-20}; shift ;;
+    --regression) regression=1; time=${RTFUSE_FUZZ_SECONDS:-10}; shift ;;
     -h|--help) sed -n '2,22p' "$0"; exit 0 ;;
     -*) echo "fuzz.sh: unknown option $1" >&2; exit 2 ;;
     *) harnesses+=("$1"); shift ;;

@@ -35,7 +35,10 @@ case "$kind" in
     export ASAN_OPTIONS="detect_leaks=1:abort_on_error=0:strict_string_checks=1:detect_stack_use_after_return=1"
     export UBSAN_OPTIONS="print_stacktrace=1:halt_on_error=1"
     export LSAN_OPTIONS="suppressions=$supp/lsan.supp:print_suppressions=0"
-    (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference "$@")
+    # The quarter-hour GNSS drive is left to the native stage: its targets
+    # are the estimator's, and the same code runs here in the GNSS loop, the
+    # live GNSS run and the unit tests.
+    (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference -E '^integration_gnss_drive$' "$@")
     ;;
   tsan)
     dir="$root/build/tsan"
