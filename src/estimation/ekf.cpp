@@ -2,7 +2,7 @@
 
 #include <cmath>
 
-
+#include "estimation/lanes.hpp"
 #include "estimation/motion_model.hpp"
 #include "geometry/angles.hpp"
 
@@ -18,25 +18,75 @@ void wrap_state_angles(StateVector& x) noexcept {
 
 namespace {
 
-// a <- a F' for the motion Jacobian F, in place. F is identity except rows
-// x..vz, so only columns x..vz of a change, each a combination of a few
-// columns: column operations on a column-major matrix vectorise, and this is
-// ~700 multiply-adds instead of 3375 for a dense product.
-void right_multiply_jacobian_transpose(Ekf::PaddedMatrix& a, const MotionJacobian& j) noexcept {
-  // Written as whole-column axpys: each column is 16 doubles (8 SSE2 / NEON
-  // packets), which Eigen's small lazy products do not exploit as well.
-  const Eigen::Matrix<double, kStateSize + 1, 3> rpy = a.middleCols<3>(kRoll);
-  for (int c = 0; c < 3; ++c) {
-    a.col(kX + c) += rpy.col(0) * j.pos_rpy(c, 0) + rpy.col(1) * j.pos_rpy(c, 1) + rpy.col(2) * j.pos_rpy(c, 2);
-    a.col(kX + c) += a.col(kVx) * j.pos_vel(c, 0) + a.col(kVy) * j.pos_vel(c, 1) + a.col(kVz) * j.pos_vel(c, 2);
-    a.col(kX + c) += a.col(kAx) * j.pos_acc(c, 0) + a.col(kAy) * j.pos_acc(c, 1) + a.col(kAz) * j.pos_acc(c, 2);
+using lanes::D2;
+using lanes::load;
+using lanes::splat;
+using lanes::store;
+
+// A padded column of P: 16 doubles, 8 lane pairs.
+constexpr int kRows = kStateSize + 1;
+// Rows x..vz: the only rows of the motion Jacobian that are not identity.
+constexpr int kMoving = 9;
+
+// Row r < 9 of F applied to a column v of 16 doubles, the terms in a fixed
+// order (no contraction, so both architectures round alike).
+inline double jacobian_row_times(const MotionJacobian& j, int r, const double* v) noexcept {
+  if (r < kRoll) {
+    return v[r] + j.pos_rpy(r, 0) * v[kRoll] + j.pos_rpy(r, 1) * v[kPitch] + j.pos_rpy(r, 2) * v[kYaw] +
+           j.pos_vel(r, 0) * v[kVx] + j.pos_vel(r, 1) * v[kVy] + j.pos_vel(r, 2) * v[kVz] +
+           j.pos_acc(r, 0) * v[kAx] + j.pos_acc(r, 1) * v[kAy] + j.pos_acc(r, 2) * v[kAz];
   }
-  for (int c = 0; c < 3; ++c) {
-    a.col(kRoll + c) = rpy.col(0) * j.rpy_rpy(c, 0) + rpy.col(1) * j.rpy_rpy(c, 1) + rpy.col(2) * j.rpy_rpy(c, 2) +
-                       a.col(kVroll) * j.rpy_rate(c, 0) + a.col(kVpitch) * j.rpy_rate(c, 1) +
-                       a.col(kVyaw) * j.rpy_rate(c, 2);
+  if (r < kVx) {
+    const int c = r - kRoll;
+    return j.rpy_rpy(c, 0) * v[kRoll] + j.rpy_rpy(c, 1) * v[kPitch] + j.rpy_rpy(c, 2) * v[kYaw] +
+           j.rpy_rate(c, 0) * v[kVroll] + j.rpy_rate(c, 1) * v[kVpitch] + j.rpy_rate(c, 2) * v[kVyaw];
   }
-  a.middleCols<3>(kVx) += j.vel_acc * a.middleCols<3>(kAx);
+  return v[r] + j.vel_acc * v[kAx + (r - kVx)];
+}
+
+// P <- F P F' on the upper triangle (the caller mirrors it). With A = P F',
+// F P F' = F A, and F's rows vroll..az are unit rows, so only two pieces
+// of F A need arithmetic:
+//  - A itself, of which only columns x..vz differ from P: each is row c of F
+//    applied to P's columns, whole columns in lane pairs (~390 two-lane
+//    multiply-adds);
+//  - the 9 x 9 upper block of rows and columns x..vz, rows of F applied to
+//    A's columns (~310 scalar multiply-adds).
+// Column b >= vroll needs none: (F A)(a, b) = (F A)(b, a) = A(b, a) because
+// row b of F is e_b, and the block vroll..az keeps P's values. Two full
+// column passes with a transpose between them did ~860 two-lane
+// multiply-adds and 256 strided copies.
+void propagate_covariance(Ekf::PaddedMatrix& p, const MotionJacobian& j) noexcept {
+  alignas(16) double a[kMoving][kRows];  // columns x..vz of A = P F'
+  const double* pc = p.data();
+  for (int q = 0; q < kRows; q += 2) {
+    const auto at = [&](int col) { return load(pc + col * kRows + q); };
+    const D2 rpy[3] = {at(kRoll), at(kPitch), at(kYaw)};
+    const D2 vel[3] = {at(kVx), at(kVy), at(kVz)};
+    const D2 rate[3] = {at(kVroll), at(kVpitch), at(kVyaw)};
+    const D2 acc[3] = {at(kAx), at(kAy), at(kAz)};
+    for (int c = 0; c < 3; ++c) {
+      D2 s = at(kX + c);
+      for (int k = 0; k < 3; ++k) s += splat(j.pos_rpy(c, k)) * rpy[k];
+      for (int k = 0; k < 3; ++k) s += splat(j.pos_vel(c, k)) * vel[k];
+      for (int k = 0; k < 3; ++k) s += splat(j.pos_acc(c, k)) * acc[k];
+      store(a[kX + c] + q, s);
+    }
+    for (int c = 0; c < 3; ++c) {
+      D2 s = splat(j.rpy_rpy(c, 0)) * rpy[0];
+      for (int k = 1; k < 3; ++k) s += splat(j.rpy_rpy(c, k)) * rpy[k];
+      for (int k = 0; k < 3; ++k) s += splat(j.rpy_rate(c, k)) * rate[k];
+      store(a[kRoll + c] + q, s);
+    }
+    for (int c = 0; c < 3; ++c) store(a[kVx + c] + q, vel[c] + splat(j.vel_acc) * acc[c]);
+  }
+  double* pm = p.data();
+  for (int b = kMoving; b < kStateSize; ++b) {
+    for (int r = 0; r < kMoving; ++r) pm[b * kRows + r] = a[r][b];
+  }
+  for (int b = 0; b < kMoving; ++b) {
+    for (int r = 0; r <= b; ++r) pm[b * kRows + r] = jacobian_row_times(j, r, a[b]);
+  }
 }
 
 }  // namespace
@@ -46,33 +96,49 @@ void Ekf::predict(double dt) noexcept {
   // The Jacobian is evaluated at the prior state, as robot_localization does.
   const MotionJacobian j = motion_model_step(x_, dt);
   wrap_state_angles(x_);
+  propagate_covariance(p_, j);
 
-  // F P F' = (P F')' F' because P is symmetric: two passes of column
-  // operations with a transpose between them.
-  PaddedMatrix a = p_;
-  right_multiply_jacobian_transpose(a, j);
-  p_ = a.transpose();
-  right_multiply_jacobian_transpose(p_, j);
-
-  if (dynamic_process_noise_) {
-    // robot_localization scales the pose block of Q by the norm of the full
-    // twist (linear and angular together), on both sides.
-    const double speed2 = x_.segment<6>(kVx).squaredNorm();
-    p_.topLeftCorner<6, 6>() += process_noise_.topLeftCorner<6, 6>() * (speed2 * dt);
-    p_.bottomRows<10>() += process_noise_.bottomRows<10>() * dt;
-    p_.topRightCorner<6, 10>() += process_noise_.topRightCorner<6, 10>() * dt;
-  } else if (process_noise_diagonal_) {
-    p_.diagonal() += process_noise_.diagonal() * dt;
-  } else {
-    p_ += process_noise_ * dt;
-  }
+  add_process_noise(dt);
   condition_covariance();
 }
 
+void Ekf::add_process_noise(double dt) noexcept {
+  // robot_localization scales the pose block of Q by the squared norm of the
+  // full twist (linear and angular together), on both sides.
+  const double pose_dt = dynamic_process_noise_ ? x_.segment<6>(kVx).squaredNorm() * dt : dt;
+  if (process_noise_diagonal_) {
+    // robot_localization configs are nearly always diagonal.
+    for (int i = 0; i < kStateSize; ++i) p_(i, i) += process_noise_(i, i) * (i < 6 ? pose_dt : dt);
+    return;
+  }
+  // The upper triangle only; condition_covariance mirrors it. Lane pairs
+  // never straddle the pose block's edge at row 6.
+  double* pm = p_.data();
+  const double* qm = process_noise_.data();
+  for (int c = 0; c < kStateSize; ++c) {
+    for (int r = 0; r <= c; r += 2) {
+      const double f = (c < 6 && r < 6) ? pose_dt : dt;
+      store(pm + c * kRows + r, load(pm + c * kRows + r) + load(qm + c * kRows + r) * splat(f));
+    }
+  }
+}
+
 void Ekf::condition_covariance() noexcept {
-  // Round-off makes P drift from symmetric; mirror the upper triangle so it
-  // stays exactly symmetric (a copy, no arithmetic).
-  p_.triangularView<Eigen::StrictlyLower>() = p_.transpose();
+  // The predict and the update compute the upper triangle only; the mirror
+  // makes P exactly symmetric (a copy, no arithmetic), as 2 x 2 blocks so
+  // that every access is a lane pair.
+  double* pm = p_.data();
+  for (int c = 0; c < kRows; c += 2) {
+    pm[c * kRows + c + 1] = pm[(c + 1) * kRows + c];
+    for (int r = c + 2; r < kRows; r += 2) {
+      // Upper block rows c, c+1 of columns r, r+1 -> lower block rows r, r+1
+      // of columns c, c+1.
+      const D2 u0 = load(pm + r * kRows + c);
+      const D2 u1 = load(pm + (r + 1) * kRows + c);
+      store(pm + c * kRows + r, D2{u0[0], u1[0]});
+      store(pm + (c + 1) * kRows + r, D2{u0[1], u1[1]});
+    }
+  }
   // Scaling row and column i by s is a congruence with diag(.., s, ..): it
   // keeps P positive semi-definite while bringing P(i,i) down to the cap.
   for (int i = 0; i < kStateSize; ++i) {
@@ -127,21 +193,24 @@ CorrectResult Ekf::correct(const Measurement& m) noexcept {
 
 namespace {
 
-// Cholesky factor S = L L' of a symmetric positive-definite N x N matrix in
-// plain fixed-size loops (Eigen's LLT dispatches to blocked kernels whose set-up
-// dominates at these sizes). Stores 1/L(j,j) so later steps never divide.
+// S = L D L' with unit lower L, for a symmetric positive-definite N x N
+// matrix, in plain fixed-size loops (Eigen's decompositions dispatch to
+// blocked kernels whose set-up dominates at these sizes). LDL' rather than
+// Cholesky: no square roots, whose latency would sit on the factorisation's
+// serial chain, once per column. Stores 1/D so later steps never divide.
 // Returns false when s is not positive definite.
 template <int N>
-bool cholesky(const Eigen::Matrix<double, N, N>& s, double (&l)[N][N], double (&d_inv)[N]) noexcept {
+bool factor_ldlt(const Eigen::Matrix<double, N, N>& s, double (&l)[N][N], double (&d_inv)[N]) noexcept {
+  double ld[N][N];  // L D, below the diagonal
   for (int j = 0; j < N; ++j) {
     double d = s(j, j);
-    for (int k = 0; k < j; ++k) d -= l[j][k] * l[j][k];
+    for (int k = 0; k < j; ++k) d -= ld[j][k] * l[j][k];
     if (!(d > 0.0) || !std::isfinite(d)) return false;
-    l[j][j] = std::sqrt(d);
-    d_inv[j] = 1.0 / l[j][j];
+    d_inv[j] = 1.0 / d;
     for (int i = j + 1; i < N; ++i) {
       double v = s(i, j);
-      for (int k = 0; k < j; ++k) v -= l[i][k] * l[j][k];
+      for (int k = 0; k < j; ++k) v -= ld[i][k] * l[j][k];
+      ld[i][j] = v;
       l[i][j] = v * d_inv[j];
     }
   }
@@ -154,24 +223,30 @@ bool cholesky(const Eigen::Matrix<double, N, N>& s, double (&l)[N][N], double (&
 // gathers and no H is ever formed. Dispatching on the update size N keeps
 // every matrix fixed-size (no Eigen::Dynamic, no allocation).
 //
-// With S = L L', everything is done on rows of 16 contiguous doubles (whole
-// SSE2/NEON packets, independent lanes): U' (its rows are columns of the
-// symmetric P), V' = L^-1 U', K' = L^-T V' = S^-1 U', and (K S)' = L V'.
-// No inverse is formed, and the Mahalanobis distance is |L^-1 innovation|^2.
+// With S = L D L' and V = L^-1 H P (N rows of 16 contiguous doubles, since
+// row k of H P is column idx[k] of the symmetric P) and W = D^-1 V: the gain
+// is K = W' L^-1, the state moves by K innovation = W' z with z = L^-1
+// innovation, and the covariance update (I - K H) P = P - W' V is a
+// symmetric rank-N downdate, computed on the upper triangle only: ~N x 64
+// two-lane multiply-adds, against ~4.8k for the Joseph form this replaced
+// at N = 9. The Joseph form also holds for a suboptimal gain, which this
+// filter never uses; what it bought, positive semi-definiteness under
+// round-off, is checked instead: a variance the downdate would make negative
+// (possible only when a prior variance exceeds the measurement's by ~15
+// orders of magnitude, where the posterior is round-off in any form) rejects
+// the update as numeric, a counted outcome, rather than enter P.
 template <int N>
 CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept {
   using VecN = Eigen::Matrix<double, N, 1>;
   using MatN = Eigen::Matrix<double, N, N>;
-  using RowsN = Eigen::Matrix<double, N, kStateSize + 1, Eigen::RowMajor>;
+  constexpr int kPairs = kRows / 2;
 
   VecN innovation;
   MatN s;
-  RowsN ut;  // U' = H P
   for (int a = 0; a < N; ++a) {
     const int ia = idx[a];
     innovation(a) = m.z(ia) - x_(ia);
     if (is_angle_index(ia)) innovation(a) = wrap_angle(innovation(a));
-    ut.row(a) = p_.col(ia).transpose();
     for (int b = 0; b < N; ++b) s(a, b) = m.covariance(ia, idx[b]) + p_(ia, idx[b]);
     // As robot_localization: negative variances are taken as their magnitude
     // and near-zero ones floored, so a "perfect" sensor cannot make S singular.
@@ -180,63 +255,95 @@ CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept 
   }
 
   CorrectResult result;
-  double l[N][N] = {};
+  double l[N][N];
   double d_inv[N];
-  if (!cholesky<N>(s, l, d_inv)) {
+  if (!factor_ldlt<N>(s, l, d_inv)) {
     result.outcome = CorrectOutcome::kRejectedNumeric;
     return result;
   }
-  // y = L^-1 innovation; squared Mahalanobis distance = y'y.
-  VecN y;
+  // z = L^-1 innovation; squared Mahalanobis distance = z' D^-1 z.
+  double z[N];
+  double mahalanobis2 = 0.0;
   for (int k = 0; k < N; ++k) {
     double v = innovation(k);
-    for (int j = 0; j < k; ++j) v -= l[k][j] * y(j);
-    y(k) = v * d_inv[k];
+    for (int j = 0; j < k; ++j) v -= l[k][j] * z[j];
+    z[k] = v;
+    mahalanobis2 += v * (v * d_inv[k]);
   }
-  result.squared_mahalanobis = y.squaredNorm();
-  if (!std::isfinite(result.squared_mahalanobis) ||
-      result.squared_mahalanobis >= m.mahalanobis_threshold * m.mahalanobis_threshold) {
-    result.outcome = std::isfinite(result.squared_mahalanobis)
-                         ? CorrectOutcome::kRejectedMahalanobis
-                         : CorrectOutcome::kRejectedNumeric;
+  result.squared_mahalanobis = mahalanobis2;
+  if (!std::isfinite(mahalanobis2) || mahalanobis2 >= m.mahalanobis_threshold * m.mahalanobis_threshold) {
+    result.outcome = std::isfinite(mahalanobis2) ? CorrectOutcome::kRejectedMahalanobis
+                                                 : CorrectOutcome::kRejectedNumeric;
     return result;
   }
 
-  RowsN vt;  // V' = L^-1 U'
+  // V = L^-1 H P by forward substitution, a whole row (8 lane pairs, 8
+  // independent chains) at a time; W = D^-1 V.
+  alignas(16) double v[N][kRows];
+  alignas(16) double w[N][kRows];
+  double* pm = p_.data();
   for (int k = 0; k < N; ++k) {
-    vt.row(k) = ut.row(k);
-    for (int j = 0; j < k; ++j) vt.row(k) -= l[k][j] * vt.row(j);
-    vt.row(k) *= d_inv[k];
+    const double* hp = pm + idx[k] * kRows;
+    D2 acc[kPairs];
+    for (int q = 0; q < kPairs; ++q) acc[q] = load(hp + 2 * q);
+    for (int j = 0; j < k; ++j) {
+      const D2 f = splat(l[k][j]);
+      for (int q = 0; q < kPairs; ++q) acc[q] -= f * load(v[j] + 2 * q);
+    }
+    const D2 scale = splat(d_inv[k]);
+    for (int q = 0; q < kPairs; ++q) {
+      store(v[k] + 2 * q, acc[q]);
+      store(w[k] + 2 * q, acc[q] * scale);
+    }
   }
-  RowsN kt;  // K' = L^-T V'
-  for (int k = N - 1; k >= 0; --k) {
-    kt.row(k) = vt.row(k);
-    for (int j = k + 1; j < N; ++j) kt.row(k) -= l[j][k] * kt.row(j);
-    kt.row(k) *= d_inv[k];
+  // x += W' z.
+  alignas(16) double dx[kRows];
+  {
+    D2 acc[kPairs];
+    for (int q = 0; q < kPairs; ++q) acc[q] = load(w[0] + 2 * q) * splat(z[0]);
+    for (int k = 1; k < N; ++k) {
+      const D2 f = splat(z[k]);
+      for (int q = 0; q < kPairs; ++q) acc[q] += load(w[k] + 2 * q) * f;
+    }
+    for (int q = 0; q < kPairs; ++q) store(dx + 2 * q, acc[q]);
   }
-  // x += K innovation = V y.
-  const StateVector x_new = x_ + (vt.transpose() * y).template head<kStateSize>();
-
-  // Joseph form (I-KH) P (I-KH)' + K R K', expanded for a selection H:
-  //   P - K U' - U K' + K S K'  with U = P H', S = H P H' + R.
-  // It equals the product form for any gain K (no optimality assumed) and is
-  // symmetric by construction as P + B + B' with B = W K', W = K S / 2 - U;
-  // here W' = (L V') / 2 - U'.
-  RowsN wt;
-  for (int k = 0; k < N; ++k) {
-    wt.row(k) = -ut.row(k);
-    for (int j = 0; j <= k; ++j) wt.row(k) += (0.5 * l[k][j]) * vt.row(j);
+  StateVector x_new;
+  for (int i = 0; i < kStateSize; ++i) x_new(i) = x_(i) + dx[i];
+  // The new variances, summed in the order the downdate below uses, so the
+  // check sees exactly the values that will be stored. Finite sums also
+  // bound every off-diagonal term (Cauchy-Schwarz): nothing else can
+  // overflow. The padding's variance is 0 - 0 and always passes.
+  {
+    D2 var[kPairs];
+    for (int q = 0; q < kPairs; ++q) var[q] = D2{pm[2 * q * (kRows + 1)], pm[(2 * q + 1) * (kRows + 1)]};
+    for (int k = 0; k < N; ++k) {
+      for (int q = 0; q < kPairs; ++q) var[q] -= load(w[k] + 2 * q) * load(v[k] + 2 * q);
+    }
+    bool ok = true;
+    for (int q = 0; q < kPairs; ++q) {
+      ok = ok && var[q][0] >= 0.0 && std::isfinite(var[q][0]) && var[q][1] >= 0.0 && std::isfinite(var[q][1]);
+    }
+    if (!ok) {
+      result.outcome = CorrectOutcome::kRejectedNumeric;
+      return result;
+    }
   }
-  const PaddedMatrix b = wt.transpose().lazyProduct(kt);
-  const PaddedMatrix p_new = p_ + b + b.transpose();
-
-  if (!x_new.allFinite() || !p_new.allFinite()) {
+  if (!x_new.allFinite()) {
     result.outcome = CorrectOutcome::kRejectedNumeric;
     return result;
+  }
+  // P -= W' V on the upper triangle, column by column (a pair may reach one
+  // row below the diagonal; the mirror overwrites it).
+  for (int c = 0; c < kStateSize; ++c) {
+    double* col = pm + c * kRows;
+    for (int r = 0; r <= c; r += 2) {
+      D2 acc = load(col + r);
+      for (int k = 0; k < N; ++k) acc -= load(w[k] + r) * splat(v[k][c]);
+      store(col + r, acc);
+    }
   }
   x_ = x_new;
   wrap_state_angles(x_);
-  p_ = p_new;
   condition_covariance();
   result.outcome = CorrectOutcome::kFused;
   result.fused_variables = N;

@@ -10,7 +10,8 @@ enum class CorrectOutcome : std::uint8_t {
   kFused,                 // at least one variable fused
   kNothingToFuse,         // empty mask, or every masked value was NaN
   kRejectedMahalanobis,   // innovation beyond the measurement's threshold
-  kRejectedNumeric,       // innovation covariance not positive definite, or non-finite result
+  kRejectedNumeric,       // innovation covariance not positive definite, a non-finite
+                          // result, or a variance the update would make negative
 };
 
 struct CorrectResult {
@@ -50,12 +51,15 @@ class Ekf {
 
   // x <- f(x, dt); P <- F P F' + Q dt, with P kept symmetric and capped.
   void predict(double dt) noexcept;
-  // Sequential update with the masked variables of m; Joseph-form covariance.
+  // One update with the masked variables of m: the optimal gain, and the
+  // covariance as a rank-N downdate that is checked never to leave a
+  // negative variance (see ekf.cpp).
   CorrectResult correct(const Measurement& m) noexcept;
 
  private:
   template <int N>
   CorrectResult correct_fixed(const Measurement& m, const int* idx) noexcept;
+  void add_process_noise(double dt) noexcept;
   void condition_covariance() noexcept;
 
   StateVector x_ = StateVector::Zero();
