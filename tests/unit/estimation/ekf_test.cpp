@@ -11,6 +11,7 @@
 
 #include "estimation/motion_model.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/random_fusion_subset.hpp"
 
 namespace rtfuse::est {
 namespace {
@@ -81,11 +82,7 @@ TEST(Ekf, CorrectMatchesTextbookJosephFormForEverySubsetSize) {
     ekf.set_covariance(p);
 
     // A random subset of `size` variables, correlated measurement noise.
-    std::vector<int> all(kStateSize);
-    for (int i = 0; i < kStateSize; ++i) all[i] = i;
-    std::shuffle(all.begin(), all.end(), rng);
-    std::vector<int> idx(all.begin(), all.begin() + size);
-    std::sort(idx.begin(), idx.end());
+    const std::vector<int> idx = test::random_fusion_subset(rng, size);
     Measurement m;
     for (int i : idx) m.mask |= mask_bit(i);
     for (int i = 0; i < kStateSize; ++i) m.z(i) = x(i) + 0.2 * n(rng);

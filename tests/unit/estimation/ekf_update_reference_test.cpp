@@ -13,6 +13,7 @@
 
 #include "estimation/ekf.hpp"
 #include "geometry/angles.hpp"
+#include "support/random_fusion_subset.hpp"
 
 namespace rtfuse::est {
 namespace {
@@ -82,11 +83,7 @@ TEST(EkfUpdateReference, DowndateMatchesLongDoubleJosephAtEverySizeAndConditioni
         StateVector x;
         for (int i = 0; i < kStateSize; ++i) x(i) = 0.1 * n(rng);
 
-        std::vector<int> all(kStateSize);
-        for (int i = 0; i < kStateSize; ++i) all[i] = i;
-        std::shuffle(all.begin(), all.end(), rng);
-        std::vector<int> idx(all.begin(), all.begin() + size);
-        std::sort(idx.begin(), idx.end());
+        const std::vector<int> idx = test::random_fusion_subset(rng, size);
         Measurement m;
         for (int i : idx) m.mask |= mask_bit(i);
         for (int i = 0; i < kStateSize; ++i) m.z(i) = x(i) + std::sqrt(p(i, i)) * 0.5 * n(rng);
