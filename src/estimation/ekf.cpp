@@ -228,13 +228,13 @@ bool factor_ldlt(const Eigen::Matrix<double, N, N>& s, double (&l)[N][N], double
 // is K = W' L^-1, the state moves by K innovation = W' z with z = L^-1
 // innovation, and the covariance update (I - K H) P = P - W' V is a
 // symmetric rank-N downdate, computed on the upper triangle only: ~N x 64
-// two-lane multiply-adds, against ~4.8k for the Joseph form this replaced
-// at N = 9. The Joseph form also holds for a suboptimal gain, which this
-// filter never uses; what it bought, positive semi-definiteness under
-// round-off, is checked instead: a variance the downdate would make negative
-// (possible only when a prior variance exceeds the measurement's by ~15
-// orders of magnitude, where the posterior is round-off in any form) rejects
-// the update as numeric, a counted outcome, rather than enter P.
+// two-lane multiply-adds, against ~4.8k scalar ones at N = 9 for the Joseph
+// form this replaced. The Joseph form also holds for a suboptimal gain,
+// which this filter never uses; what it bought, positive semi-definiteness
+// under round-off, is checked instead: a variance the downdate would make
+// negative (round-off can, when P has drifted an ulp outside the cone or a
+// prior variance exceeds the measurement's by ~15 orders of magnitude)
+// rejects the update as numeric, a counted outcome, rather than enter P.
 template <int N>
 CorrectResult Ekf::correct_fixed(const Measurement& m, const int* idx) noexcept {
   using VecN = Eigen::Matrix<double, N, 1>;
