@@ -28,64 +28,121 @@ constexpr int kRows = kStateSize + 1;
 // Rows x..vz: the only rows of the motion Jacobian that are not identity.
 constexpr int kMoving = 9;
 
-// Row r < 9 of F applied to a column v of 16 doubles, the terms in a fixed
-// order (no contraction, so both architectures round alike).
-inline double jacobian_row_times(const MotionJacobian& j, int r, const double* v) noexcept {
-  if (r < kRoll) {
-    return v[r] + j.pos_rpy(r, 0) * v[kRoll] + j.pos_rpy(r, 1) * v[kPitch] + j.pos_rpy(r, 2) * v[kYaw] +
-           j.pos_vel(r, 0) * v[kVx] + j.pos_vel(r, 1) * v[kVy] + j.pos_vel(r, 2) * v[kVz] +
-           j.pos_acc(r, 0) * v[kAx] + j.pos_acc(r, 1) * v[kAy] + j.pos_acc(r, 2) * v[kAz];
-  }
-  if (r < kVx) {
-    const int c = r - kRoll;
-    return j.rpy_rpy(c, 0) * v[kRoll] + j.rpy_rpy(c, 1) * v[kPitch] + j.rpy_rpy(c, 2) * v[kYaw] +
-           j.rpy_rate(c, 0) * v[kVroll] + j.rpy_rate(c, 1) * v[kVpitch] + j.rpy_rate(c, 2) * v[kVyaw];
-  }
-  return v[r] + j.vel_acc * v[kAx + (r - kVx)];
+// Rows x..vz of F applied to a column v of A (16 doubles), one function per
+// row shape, the terms in a fixed order (no contraction, so both
+// architectures round alike). F's position rows are
+// [I, dR/drpy s, R dt, 0, R dt^2/2]: with w = v[vel] + (dt/2) v[acc] their
+// velocity and acceleration terms are one product R dt w. The rest skips the
+// Jacobian's structural zeros and ones (motion_model.hpp); the dense-product
+// test (ekf_test) would catch an entry that stopped being one.
+inline double position_row_times(const MotionJacobian& j, int r, const double* v, const double* w) noexcept {
+  return v[r] + j.pos_rpy(r, 0) * v[kRoll] + j.pos_rpy(r, 1) * v[kPitch] + j.pos_rpy(r, 2) * v[kYaw] +
+         j.pos_vel(r, 0) * w[0] + j.pos_vel(r, 1) * w[1] + j.pos_vel(r, 2) * w[2];
+}
+inline double z_row_times(const MotionJacobian& j, const double* v, const double* w) noexcept {
+  return v[kZ] + j.pos_rpy(2, 0) * v[kRoll] + j.pos_rpy(2, 1) * v[kPitch] + j.pos_vel(2, 0) * w[0] +
+         j.pos_vel(2, 1) * w[1] + j.pos_vel(2, 2) * w[2];
+}
+inline double roll_row_times(const MotionJacobian& j, const double* v) noexcept {
+  return j.rpy_rpy(0, 0) * v[kRoll] + j.rpy_rpy(0, 1) * v[kPitch] + j.rpy_rate(0, 0) * v[kVroll] +
+         j.rpy_rate(0, 1) * v[kVpitch] + j.rpy_rate(0, 2) * v[kVyaw];
+}
+inline double pitch_row_times(const MotionJacobian& j, const double* v) noexcept {
+  return v[kPitch] + j.rpy_rpy(1, 0) * v[kRoll] + j.rpy_rate(1, 1) * v[kVpitch] + j.rpy_rate(1, 2) * v[kVyaw];
+}
+inline double yaw_row_times(const MotionJacobian& j, const double* v) noexcept {
+  return v[kYaw] + j.rpy_rpy(2, 0) * v[kRoll] + j.rpy_rpy(2, 1) * v[kPitch] + j.rpy_rate(2, 1) * v[kVpitch] +
+         j.rpy_rate(2, 2) * v[kVyaw];
 }
 
-// P <- F P F' on the upper triangle (the caller mirrors it). With A = P F',
-// F P F' = F A, and F's rows vroll..az are unit rows, so only two pieces
-// of F A need arithmetic:
-//  - A itself, of which only columns x..vz differ from P: each is row c of F
-//    applied to P's columns, whole columns in lane pairs (~390 two-lane
-//    multiply-adds);
-//  - the 9 x 9 upper block of rows and columns x..vz, rows of F applied to
-//    A's columns (~310 scalar multiply-adds).
-// Column b >= vroll needs none: (F A)(a, b) = (F A)(b, a) = A(b, a) because
-// row b of F is e_b, and the block vroll..az keeps P's values. Two full
-// column passes with a transpose between them did ~860 two-lane
-// multiply-adds and 256 strided copies.
-void propagate_covariance(Ekf::PaddedMatrix& p, const MotionJacobian& j) noexcept {
+// P <- F P F' + Q on both triangles, P exactly symmetric on entry and on
+// exit. With A = P F', F P F' = F A, and F's rows vroll..az are unit rows,
+// so the arithmetic is in two pieces:
+//  - A's columns x..vz (the others equal P's): rows of F applied to P's
+//    columns, whole columns in lane pairs (~280 two-lane multiply-adds);
+//  - the 9 x 9 upper block of rows and columns x..vz: rows of F applied to
+//    A's columns (~220 scalar multiply-adds), then mirrored.
+// Everything else is a copy: rows vroll..az of column b < 9 are A's
+// (contiguous), and by symmetry so are row b's columns vroll..az; the block
+// vroll..az keeps P's values. Q is added as each entry is written, so P is
+// read and written once. kDenseNoise false: Q is diagonal (as
+// robot_localization configs nearly always are) and only the diagonal is
+// touched. `pose_f` scales Q's pose block, `f` the rest.
+template <bool kDenseNoise>
+void propagate_covariance(Ekf::PaddedMatrix& p, const MotionJacobian& j, const Ekf::PaddedMatrix& q,
+                          double pose_f, double f) noexcept {
   alignas(16) double a[kMoving][kRows];  // columns x..vz of A = P F'
   const double* pc = p.data();
-  for (int q = 0; q < kRows; q += 2) {
-    const auto at = [&](int col) { return load(pc + col * kRows + q); };
+  const D2 half_dt = splat(0.5 * j.vel_acc);
+  for (int r = 0; r < kRows; r += 2) {
+    const auto at = [&](int col) { return load(pc + col * kRows + r); };
     const D2 rpy[3] = {at(kRoll), at(kPitch), at(kYaw)};
-    const D2 vel[3] = {at(kVx), at(kVy), at(kVz)};
     const D2 rate[3] = {at(kVroll), at(kVpitch), at(kVyaw)};
-    const D2 acc[3] = {at(kAx), at(kAy), at(kAz)};
-    for (int c = 0; c < 3; ++c) {
-      D2 s = at(kX + c);
-      for (int k = 0; k < 3; ++k) s += splat(j.pos_rpy(c, k)) * rpy[k];
-      for (int k = 0; k < 3; ++k) s += splat(j.pos_vel(c, k)) * vel[k];
-      for (int k = 0; k < 3; ++k) s += splat(j.pos_acc(c, k)) * acc[k];
-      store(a[kX + c] + q, s);
+    D2 vel[3], w[3];
+    for (int k = 0; k < 3; ++k) {
+      vel[k] = at(kVx + k);
+      const D2 acc = at(kAx + k);
+      w[k] = vel[k] + half_dt * acc;
+      store(a[kVx + k] + r, vel[k] + splat(j.vel_acc) * acc);
     }
-    for (int c = 0; c < 3; ++c) {
-      D2 s = splat(j.rpy_rpy(c, 0)) * rpy[0];
-      for (int k = 1; k < 3; ++k) s += splat(j.rpy_rpy(c, k)) * rpy[k];
-      for (int k = 0; k < 3; ++k) s += splat(j.rpy_rate(c, k)) * rate[k];
-      store(a[kRoll + c] + q, s);
+    for (int c = 0; c < 2; ++c) {
+      store(a[kX + c] + r, at(kX + c) + splat(j.pos_rpy(c, 0)) * rpy[0] + splat(j.pos_rpy(c, 1)) * rpy[1] +
+                               splat(j.pos_rpy(c, 2)) * rpy[2] + splat(j.pos_vel(c, 0)) * w[0] +
+                               splat(j.pos_vel(c, 1)) * w[1] + splat(j.pos_vel(c, 2)) * w[2]);
     }
-    for (int c = 0; c < 3; ++c) store(a[kVx + c] + q, vel[c] + splat(j.vel_acc) * acc[c]);
+    store(a[kZ] + r, at(kZ) + splat(j.pos_rpy(2, 0)) * rpy[0] + splat(j.pos_rpy(2, 1)) * rpy[1] +
+                         splat(j.pos_vel(2, 0)) * w[0] + splat(j.pos_vel(2, 1)) * w[1] +
+                         splat(j.pos_vel(2, 2)) * w[2]);
+    store(a[kRoll] + r, splat(j.rpy_rpy(0, 0)) * rpy[0] + splat(j.rpy_rpy(0, 1)) * rpy[1] +
+                            splat(j.rpy_rate(0, 0)) * rate[0] + splat(j.rpy_rate(0, 1)) * rate[1] +
+                            splat(j.rpy_rate(0, 2)) * rate[2]);
+    store(a[kPitch] + r, rpy[1] + splat(j.rpy_rpy(1, 0)) * rpy[0] + splat(j.rpy_rate(1, 1)) * rate[1] +
+                             splat(j.rpy_rate(1, 2)) * rate[2]);
+    store(a[kYaw] + r, rpy[2] + splat(j.rpy_rpy(2, 0)) * rpy[0] + splat(j.rpy_rpy(2, 1)) * rpy[1] +
+                           splat(j.rpy_rate(2, 1)) * rate[1] + splat(j.rpy_rate(2, 2)) * rate[2]);
   }
+
   double* pm = p.data();
+  const double* qm = q.data();
+  const D2 lane_f = splat(f);
+  // Rows vroll..az (9..14) are three unaligned lane pairs; row 15 is padding.
   for (int b = kMoving; b < kStateSize; ++b) {
-    for (int r = 0; r < kMoving; ++r) pm[b * kRows + r] = a[r][b];
+    double* col = pm + b * kRows;
+    const double* qcol = qm + b * kRows;
+    for (int r = 0; r < kMoving; ++r) col[r] = kDenseNoise ? a[r][b] + qcol[r] * f : a[r][b];
+    if (kDenseNoise) {
+      for (int r = kMoving; r < kStateSize; r += 2) store(col + r, load(col + r) + load(qcol + r) * lane_f);
+    } else {
+      col[b] += qcol[b] * f;
+    }
   }
+  for (int c = 0; c < kMoving; ++c) {
+    double* col = pm + c * kRows;
+    const double* qcol = qm + c * kRows;
+    for (int r = kMoving; r < kStateSize; r += 2) {
+      store(col + r, kDenseNoise ? load(a[c] + r) + load(qcol + r) * lane_f : load(a[c] + r));
+    }
+  }
+  // The 9 x 9 block, row by row so that each row's shape is straight-line
+  // code: entry (r, b) for b >= r, mirrored to (b, r).
+  double w[kMoving][3];
   for (int b = 0; b < kMoving; ++b) {
-    for (int r = 0; r <= b; ++r) pm[b * kRows + r] = jacobian_row_times(j, r, a[b]);
+    for (int k = 0; k < 3; ++k) w[b][k] = a[b][kVx + k] + 0.5 * j.vel_acc * a[b][kAx + k];
+  }
+  const auto put = [&](int r, int b, double e) {
+    if (kDenseNoise || r == b) e += qm[b * kRows + r] * (r < 6 && b < 6 ? pose_f : f);
+    pm[b * kRows + r] = e;
+    pm[r * kRows + b] = e;
+  };
+  for (int r = kX; r <= kY; ++r) {
+    for (int b = r; b < kMoving; ++b) put(r, b, position_row_times(j, r, a[b], w[b]));
+  }
+  for (int b = kZ; b < kMoving; ++b) put(kZ, b, z_row_times(j, a[b], w[b]));
+  for (int b = kRoll; b < kMoving; ++b) put(kRoll, b, roll_row_times(j, a[b]));
+  for (int b = kPitch; b < kMoving; ++b) put(kPitch, b, pitch_row_times(j, a[b]));
+  for (int b = kYaw; b < kMoving; ++b) put(kYaw, b, yaw_row_times(j, a[b]));
+  for (int r = kVx; r < kMoving; ++r) {
+    for (int b = r; b < kMoving; ++b) put(r, b, a[b][r] + j.vel_acc * a[b][kAx + (r - kVx)]);
   }
 }
 
@@ -96,37 +153,40 @@ void Ekf::predict(double dt) noexcept {
   // The Jacobian is evaluated at the prior state, as robot_localization does.
   const MotionJacobian j = motion_model_step(x_, dt);
   wrap_state_angles(x_);
-  propagate_covariance(p_, j);
-
-  add_process_noise(dt);
-  condition_covariance();
-}
-
-void Ekf::add_process_noise(double dt) noexcept {
   // robot_localization scales the pose block of Q by the squared norm of the
-  // full twist (linear and angular together), on both sides.
+  // full twist (linear and angular together), taken after the motion step.
   const double pose_dt = dynamic_process_noise_ ? x_.segment<6>(kVx).squaredNorm() * dt : dt;
   if (process_noise_diagonal_) {
-    // robot_localization configs are nearly always diagonal.
-    for (int i = 0; i < kStateSize; ++i) p_(i, i) += process_noise_(i, i) * (i < 6 ? pose_dt : dt);
-    return;
+    propagate_covariance<false>(p_, j, process_noise_, pose_dt, dt);
+  } else {
+    propagate_covariance<true>(p_, j, process_noise_, pose_dt, dt);
   }
-  // The upper triangle only; condition_covariance mirrors it. Lane pairs
-  // never straddle the pose block's edge at row 6.
-  double* pm = p_.data();
-  const double* qm = process_noise_.data();
+  cap_variances();
+}
+
+void Ekf::set_process_noise(const StateMatrix& q) noexcept {
+  // From the upper triangle: the predict adds Q's (r, c) and (c, r) to the
+  // two triangles of P, which stay equal only if Q is exactly symmetric.
+  process_noise_.setZero();
   for (int c = 0; c < kStateSize; ++c) {
-    for (int r = 0; r <= c; r += 2) {
-      const double f = (c < 6 && r < 6) ? pose_dt : dt;
-      store(pm + c * kRows + r, load(pm + c * kRows + r) + load(qm + c * kRows + r) * splat(f));
-    }
+    for (int r = 0; r <= c; ++r) process_noise_(r, c) = process_noise_(c, r) = q(r, c);
+  }
+  process_noise_diagonal_ = q.isDiagonal(0.0);
+}
+
+void Ekf::set_covariance(const StateMatrix& p) noexcept {
+  // From the upper triangle, like every update of P: the predict copies
+  // rather than recomputes the block vroll..az, so symmetry has to hold on entry.
+  p_.setZero();
+  for (int c = 0; c < kStateSize; ++c) {
+    for (int r = 0; r <= c; ++r) p_(r, c) = p_(c, r) = p(r, c);
   }
 }
 
 void Ekf::condition_covariance() noexcept {
-  // The predict and the update compute the upper triangle only; the mirror
-  // makes P exactly symmetric (a copy, no arithmetic), as 2 x 2 blocks so
-  // that every access is a lane pair.
+  // The update computes the upper triangle only; the mirror makes P exactly
+  // symmetric (a copy, no arithmetic), as 2 x 2 blocks so that every access
+  // is a lane pair.
   double* pm = p_.data();
   for (int c = 0; c < kRows; c += 2) {
     pm[c * kRows + c + 1] = pm[(c + 1) * kRows + c];
@@ -139,6 +199,10 @@ void Ekf::condition_covariance() noexcept {
       store(pm + (c + 1) * kRows + r, D2{u0[1], u1[1]});
     }
   }
+  cap_variances();
+}
+
+void Ekf::cap_variances() noexcept {
   // Scaling row and column i by s is a congruence with diag(.., s, ..): it
   // keeps P positive semi-definite while bringing P(i,i) down to the cap.
   for (int i = 0; i < kStateSize; ++i) {

@@ -29,22 +29,15 @@ class Ekf {
   // through every operation, and nothing outside this class sees it.
   using PaddedMatrix = Eigen::Matrix<double, kStateSize + 1, kStateSize + 1>;
 
-  // Process noise per second (Q·dt is added per prediction).
-  void set_process_noise(const StateMatrix& q) noexcept {
-    process_noise_.setZero();
-    process_noise_.topLeftCorner<kStateSize, kStateSize>() = q;
-    // robot_localization configs are nearly always diagonal: then Q dt is a
-    // diagonal add instead of a full matrix pass.
-    process_noise_diagonal_ = q.isDiagonal(0.0);
-  }
+  // Process noise per second (Q·dt is added per prediction). Taken from the
+  // upper triangle.
+  void set_process_noise(const StateMatrix& q) noexcept;
   void set_dynamic_process_noise(bool on) noexcept { dynamic_process_noise_ = on; }
   void set_max_variance(double v) noexcept { max_variance_ = v; }
 
   void set_state(const StateVector& x) noexcept { x_ = x; }
-  void set_covariance(const StateMatrix& p) noexcept {
-    p_.setZero();
-    p_.topLeftCorner<kStateSize, kStateSize>() = p;
-  }
+  // Taken from the upper triangle: P is kept exactly symmetric.
+  void set_covariance(const StateMatrix& p) noexcept;
   const StateVector& state() const noexcept { return x_; }
   StateMatrix covariance() const noexcept { return p_.topLeftCorner<kStateSize, kStateSize>(); }
   double variance(int i) const noexcept { return p_(i, i); }
@@ -59,8 +52,8 @@ class Ekf {
  private:
   template <int N>
   CorrectResult correct_fixed(const Measurement& m, const int* idx) noexcept;
-  void add_process_noise(double dt) noexcept;
   void condition_covariance() noexcept;
+  void cap_variances() noexcept;
 
   StateVector x_ = StateVector::Zero();
   PaddedMatrix p_ = identity_covariance();

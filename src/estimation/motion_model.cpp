@@ -66,7 +66,6 @@ MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const Stat
   j.pos_rpy.col(1) = dr_dpitch * s;
   j.pos_rpy.col(2) = dr_dyaw * s;
   j.pos_vel = r * dt;
-  j.pos_acc = r * (0.5 * dt * dt);
 
   j.rpy_rpy.setIdentity();
   j.rpy_rpy(0, 0) += (t.cr * tp * vp - t.sr * tp * vy) * dt;
@@ -108,7 +107,7 @@ StateMatrix motion_model_jacobian_dense(const StateVector& x, double dt) noexcep
   StateMatrix f = StateMatrix::Identity();
   f.block<3, 3>(kX, kRoll) = j.pos_rpy;
   f.block<3, 3>(kX, kVx) = j.pos_vel;
-  f.block<3, 3>(kX, kAx) = j.pos_acc;
+  f.block<3, 3>(kX, kAx) = j.pos_vel * (0.5 * dt);
   f.block<3, 3>(kRoll, kRoll) = j.rpy_rpy;
   f.block<3, 3>(kRoll, kVroll) = j.rpy_rate;
   f.block<3, 3>(kVx, kAx) = Eigen::Matrix3d::Identity() * j.vel_acc;

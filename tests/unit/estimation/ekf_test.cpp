@@ -136,6 +136,26 @@ TEST(Ekf, JacobianMatchesNumericDifferentiation) {
   }
 }
 
+// The predict skips these entries (ekf.cpp); a model change that fills one
+// must fail here, not bias the covariance by a skipped term.
+TEST(Ekf, JacobianHasTheStructureThePredictSkips) {
+  std::mt19937 rng(17);
+  std::uniform_real_distribution<double> u(-3.0, 3.0);
+  for (int trial = 0; trial < 200; ++trial) {
+    StateVector x;
+    for (int i = 0; i < kStateSize; ++i) x(i) = u(rng);
+    x(kPitch) *= 0.45;
+    const MotionJacobian j = motion_model_jacobian(x, 0.01 + 0.001 * trial);
+    EXPECT_EQ(j.pos_rpy(2, 2), 0.0);
+    EXPECT_EQ(j.rpy_rpy(0, 2), 0.0);
+    EXPECT_EQ(j.rpy_rpy(1, 2), 0.0);
+    EXPECT_EQ(j.rpy_rpy(1, 1), 1.0);
+    EXPECT_EQ(j.rpy_rpy(2, 2), 1.0);
+    EXPECT_EQ(j.rpy_rate(1, 0), 0.0);
+    EXPECT_EQ(j.rpy_rate(2, 0), 0.0);
+  }
+}
+
 TEST(Ekf, PredictCovarianceEqualsDenseTripleProduct) {
   std::mt19937 rng(11);
   std::uniform_real_distribution<double> u(-1.0, 1.0);
