@@ -28,40 +28,14 @@ constexpr int kRows = kStateSize + 1;
 // Rows x..vz: the only rows of the motion Jacobian that are not identity.
 constexpr int kMoving = 9;
 
-// Rows x..vz of F applied to a column v of A (16 doubles), one function per
-// row shape, the terms in a fixed order (no contraction, so both
-// architectures round alike). F's position rows are
-// [I, dR/drpy s, R dt, 0, R dt^2/2]: with w = v[vel] + (dt/2) v[acc] their
-// velocity and acceleration terms are one product R dt w. The rest skips the
-// Jacobian's structural zeros and ones (motion_model.hpp); the dense-product
-// test (ekf_test) would catch an entry that stopped being one.
-inline double position_row_times(const MotionJacobian& j, int r, const double* v, const double* w) noexcept {
-  return v[r] + j.pos_rpy(r, 0) * v[kRoll] + j.pos_rpy(r, 1) * v[kPitch] + j.pos_rpy(r, 2) * v[kYaw] +
-         j.pos_vel(r, 0) * w[0] + j.pos_vel(r, 1) * w[1] + j.pos_vel(r, 2) * w[2];
-}
-inline double z_row_times(const MotionJacobian& j, const double* v, const double* w) noexcept {
-  return v[kZ] + j.pos_rpy(2, 0) * v[kRoll] + j.pos_rpy(2, 1) * v[kPitch] + j.pos_vel(2, 0) * w[0] +
-         j.pos_vel(2, 1) * w[1] + j.pos_vel(2, 2) * w[2];
-}
-inline double roll_row_times(const MotionJacobian& j, const double* v) noexcept {
-  return j.rpy_rpy(0, 0) * v[kRoll] + j.rpy_rpy(0, 1) * v[kPitch] + j.rpy_rate(0, 0) * v[kVroll] +
-         j.rpy_rate(0, 1) * v[kVpitch] + j.rpy_rate(0, 2) * v[kVyaw];
-}
-inline double pitch_row_times(const MotionJacobian& j, const double* v) noexcept {
-  return v[kPitch] + j.rpy_rpy(1, 0) * v[kRoll] + j.rpy_rate(1, 1) * v[kVpitch] + j.rpy_rate(1, 2) * v[kVyaw];
-}
-inline double yaw_row_times(const MotionJacobian& j, const double* v) noexcept {
-  return v[kYaw] + j.rpy_rpy(2, 0) * v[kRoll] + j.rpy_rpy(2, 1) * v[kPitch] + j.rpy_rate(2, 1) * v[kVpitch] +
-         j.rpy_rate(2, 2) * v[kVyaw];
-}
-
 // P <- F P F' + Q on both triangles, P exactly symmetric on entry and on
 // exit. With A = P F', F P F' = F A, and F's rows vroll..az are unit rows,
 // so the arithmetic is in two pieces:
 //  - A's columns x..vz (the others equal P's): rows of F applied to P's
 //    columns, whole columns in lane pairs (~280 two-lane multiply-adds);
 //  - the 9 x 9 upper block of rows and columns x..vz: rows of F applied to
-//    A's columns (~220 scalar multiply-adds), then mirrored.
+//    A's columns, also in lane pairs (~130 two-lane multiply-adds), then
+//    mirrored.
 // Everything else is a copy: rows vroll..az of column b < 9 are A's
 // (contiguous), and by symmetry so are row b's columns vroll..az; the block
 // vroll..az keeps P's values. Q is added as each entry is written, so P is
@@ -116,33 +90,68 @@ void propagate_covariance(Ekf::PaddedMatrix& p, const MotionJacobian& j, const E
       col[b] += qcol[b] * f;
     }
   }
+  // The 9 x 9 block: (F A)(r, b) for r <= b, column b of it as F's rows
+  // applied to A's column b, two rows per lane pair (F's entries paired once
+  // per prediction), then mirrored. F's position rows are
+  // [I, dR/drpy s, R dt, 0, R dt^2/2]: with w = v[vel] + (dt/2) v[acc] their
+  // velocity and acceleration terms are one product R dt w. The pairs skip the
+  // Jacobian's structural zeros and ones (motion_model.hpp; a test pins them).
+  const auto pair = [](double top, double bottom) { return D2{top, bottom}; };
+  D2 xy_rpy[3], xy_w[3], z_w[3], roll_rate[3];
+  for (int k = 0; k < 3; ++k) {
+    xy_rpy[k] = pair(j.pos_rpy(0, k), j.pos_rpy(1, k));
+    xy_w[k] = pair(j.pos_vel(0, k), j.pos_vel(1, k));
+    z_w[k] = pair(j.pos_vel(2, k), 0.0);
+    roll_rate[k] = pair(0.0, j.rpy_rate(0, k));
+  }
+  const D2 zr_roll = pair(j.pos_rpy(2, 0), j.rpy_rpy(0, 0));
+  const D2 zr_pitch = pair(j.pos_rpy(2, 1), j.rpy_rpy(0, 1));
+  const D2 py_roll = pair(j.rpy_rpy(1, 0), j.rpy_rpy(2, 0));
+  const D2 py_pitch = pair(0.0, j.rpy_rpy(2, 1));
+  const D2 py_vpitch = pair(j.rpy_rate(1, 1), j.rpy_rate(2, 1));
+  const D2 py_vyaw = pair(j.rpy_rate(1, 2), j.rpy_rate(2, 2));
+  const D2 lane_dt = splat(j.vel_acc);
+  for (int b = 0; b < kMoving; ++b) {
+    const double* v = a[b];
+    double* col = pm + b * kRows;
+    const double* qcol = qm + b * kRows;
+    const D2 pose_lanes = splat(b < 6 ? pose_f : f);  // rows x..yaw: the pose block if b is in it
+    const auto put = [&](int r, D2 e, D2 factor) {
+      store(col + r, kDenseNoise ? e + load(qcol + r) * factor : e);
+    };
+    D2 w[3];
+    for (int k = 0; k < 3; ++k) w[k] = splat(v[kVx + k] + 0.5 * j.vel_acc * v[kAx + k]);
+    const D2 roll = splat(v[kRoll]);
+    const D2 pitch = splat(v[kPitch]);
+    put(kX, load(v + kX) + xy_rpy[0] * roll + xy_rpy[1] * pitch + xy_rpy[2] * splat(v[kYaw]) + xy_w[0] * w[0] +
+                xy_w[1] * w[1] + xy_w[2] * w[2],
+        pose_lanes);
+    if (b >= kZ) {
+      put(kZ, pair(v[kZ], 0.0) + zr_roll * roll + zr_pitch * pitch + z_w[0] * w[0] + z_w[1] * w[1] + z_w[2] * w[2] +
+                  roll_rate[0] * splat(v[kVroll]) + roll_rate[1] * splat(v[kVpitch]) +
+                  roll_rate[2] * splat(v[kVyaw]),
+          pose_lanes);
+    }
+    if (b >= kPitch) {
+      put(kPitch, load(v + kPitch) + py_roll * roll + py_pitch * pitch + py_vpitch * splat(v[kVpitch]) +
+                      py_vyaw * splat(v[kVyaw]),
+          pose_lanes);
+    }
+    // Row pair (vz, vroll) writes vroll too: the copy below overwrites it.
+    if (b >= kVx) put(kVx, load(v + kVx) + lane_dt * load(v + kAx), lane_f);
+    if (b >= kVz) put(kVz, load(v + kVz) + lane_dt * load(v + kAz), lane_f);
+    if (!kDenseNoise) col[b] += qcol[b] * (b < 6 ? pose_f : f);
+  }
+  for (int b = 1; b < kMoving; ++b) {
+    for (int r = 0; r < b; ++r) pm[r * kRows + b] = pm[b * kRows + r];
+  }
+  // Rows vroll..az of columns x..vz: A's, after the block (see above).
   for (int c = 0; c < kMoving; ++c) {
     double* col = pm + c * kRows;
     const double* qcol = qm + c * kRows;
     for (int r = kMoving; r < kStateSize; r += 2) {
       store(col + r, kDenseNoise ? load(a[c] + r) + load(qcol + r) * lane_f : load(a[c] + r));
     }
-  }
-  // The 9 x 9 block, row by row so that each row's shape is straight-line
-  // code: entry (r, b) for b >= r, mirrored to (b, r).
-  double w[kMoving][3];
-  for (int b = 0; b < kMoving; ++b) {
-    for (int k = 0; k < 3; ++k) w[b][k] = a[b][kVx + k] + 0.5 * j.vel_acc * a[b][kAx + k];
-  }
-  const auto put = [&](int r, int b, double e) {
-    if (kDenseNoise || r == b) e += qm[b * kRows + r] * (r < 6 && b < 6 ? pose_f : f);
-    pm[b * kRows + r] = e;
-    pm[r * kRows + b] = e;
-  };
-  for (int r = kX; r <= kY; ++r) {
-    for (int b = r; b < kMoving; ++b) put(r, b, position_row_times(j, r, a[b], w[b]));
-  }
-  for (int b = kZ; b < kMoving; ++b) put(kZ, b, z_row_times(j, a[b], w[b]));
-  for (int b = kRoll; b < kMoving; ++b) put(kRoll, b, roll_row_times(j, a[b]));
-  for (int b = kPitch; b < kMoving; ++b) put(kPitch, b, pitch_row_times(j, a[b]));
-  for (int b = kYaw; b < kMoving; ++b) put(kYaw, b, yaw_row_times(j, a[b]));
-  for (int r = kVx; r < kMoving; ++r) {
-    for (int b = r; b < kMoving; ++b) put(r, b, a[b][r] + j.vel_acc * a[b][kAx + (r - kVx)]);
   }
 }
 
@@ -203,6 +212,12 @@ void Ekf::condition_covariance() noexcept {
 }
 
 void Ekf::cap_variances() noexcept {
+  // One pass of compares first: the cap nearly never bites, and a branch per
+  // variance through Eigen's indexing cost 4 % of a prediction.
+  const double* pm = p_.data();
+  bool over = false;
+  for (int i = 0; i < kStateSize; ++i) over |= pm[i * (kRows + 1)] > max_variance_;
+  if (!over) return;
   // Scaling row and column i by s is a congruence with diag(.., s, ..): it
   // keeps P positive semi-definite while bringing P(i,i) down to the cap.
   for (int i = 0; i < kStateSize; ++i) {

@@ -29,42 +29,43 @@ Eigen::Matrix3d body_to_world(const Trig& t) noexcept {
   return r;
 }
 
-void predict_with(const Trig& t, const Eigen::Matrix3d& r, StateVector& x, double dt) noexcept {
-  const Eigen::Vector3d v = x.segment<3>(kVx);
-  const Eigen::Vector3d a = x.segment<3>(kAx);
+// The position step in the world frame, R (v dt + a dt^2 / 2): the motion
+// model moves the position by it, and the Jacobian's attitude columns are
+// cross products with it, so both take it from here.
+Eigen::Vector3d world_step(const Eigen::Matrix3d& r, const StateVector& x, double dt) noexcept {
+  return r * (x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx));
+}
+
+void predict_with(const Trig& t, const Eigen::Vector3d& step, StateVector& x, double dt) noexcept {
   const double tp = t.sp / t.cp;
   const double vr = x(kVroll), vp = x(kVpitch), vy = x(kVyaw);
 
-  x.segment<3>(kX) += r * (v * dt + 0.5 * dt * dt * a);
+  x.segment<3>(kX) += step;
   // Body rates to Euler-angle rates (singular at pitch = ±pi/2, as in robot_localization).
   x(kRoll) += (vr + t.sr * tp * vp + t.cr * tp * vy) * dt;
   x(kPitch) += (t.cr * vp - t.sr * vy) * dt;
   x(kYaw) += (t.sr / t.cp * vp + t.cr / t.cp * vy) * dt;
-  x.segment<3>(kVx) += a * dt;
+  x.segment<3>(kVx) += x.segment<3>(kAx) * dt;
 }
 
-MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const StateVector& x, double dt) noexcept {
+MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const Eigen::Vector3d& step,
+                             const StateVector& x, double dt) noexcept {
   const Eigen::Vector3d s = x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx);
   const double vp = x(kVpitch), vy = x(kVyaw);
   const double tp = t.sp / t.cp;
   const double sec2 = 1.0 / (t.cp * t.cp);
 
-  // dR/droll, dR/dpitch, dR/dyaw applied to s.
-  Eigen::Matrix3d dr_droll, dr_dpitch, dr_dyaw;
-  dr_droll << 0, t.cy * t.sp * t.cr + t.sy * t.sr, -t.cy * t.sp * t.sr + t.sy * t.cr,
-              0, t.sy * t.sp * t.cr - t.cy * t.sr, -t.sy * t.sp * t.sr - t.cy * t.cr,
-              0, t.cp * t.cr,                      -t.cp * t.sr;
-  dr_dpitch << -t.cy * t.sp, t.cy * t.cp * t.sr, t.cy * t.cp * t.cr,
-               -t.sy * t.sp, t.sy * t.cp * t.sr, t.sy * t.cp * t.cr,
-               -t.cp,        -t.sp * t.sr,       -t.sp * t.cr;
-  dr_dyaw << -t.sy * t.cp, -t.sy * t.sp * t.sr - t.cy * t.cr, -t.sy * t.sp * t.cr + t.cy * t.sr,
-              t.cy * t.cp,  t.cy * t.sp * t.sr - t.sy * t.cr,  t.cy * t.sp * t.cr + t.sy * t.sr,
-              0,            0,                                  0;
-
+  // d(R s)/d(angle) for R = Rz(yaw) Ry(pitch) Rx(roll), from the derivative
+  // of a rotation about axis e being that rotation times [e]x:
+  //  roll:  R (e_x x s), R's columns 1 and 2 weighted by -s_z and s_y;
+  //  pitch: Rz (e_y x u) with u = Ry Rx s = Rz' R s;
+  //  yaw:   e_z x (R s).
+  // Cheaper than the three dR/dangle matrices times s, and it reuses R s.
   MotionJacobian j;
-  j.pos_rpy.col(0) = dr_droll * s;
-  j.pos_rpy.col(1) = dr_dpitch * s;
-  j.pos_rpy.col(2) = dr_dyaw * s;
+  j.pos_rpy.col(0) = r.col(2) * s(1) - r.col(1) * s(2);
+  const double ux = t.cy * step(0) + t.sy * step(1);
+  j.pos_rpy.col(1) << t.cy * step(2), t.sy * step(2), -ux;
+  j.pos_rpy.col(2) << -step(1), step(0), 0.0;
   j.pos_vel = r * dt;
 
   j.rpy_rpy.setIdentity();
@@ -86,19 +87,21 @@ MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const Stat
 
 void motion_model_predict(StateVector& x, double dt) noexcept {
   const Trig t = trig_of(x);
-  predict_with(t, body_to_world(t), x, dt);
+  predict_with(t, world_step(body_to_world(t), x, dt), x, dt);
 }
 
 MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept {
   const Trig t = trig_of(x);
-  return jacobian_with(t, body_to_world(t), x, dt);
+  const Eigen::Matrix3d r = body_to_world(t);
+  return jacobian_with(t, r, world_step(r, x, dt), x, dt);
 }
 
 MotionJacobian motion_model_step(StateVector& x, double dt) noexcept {
   const Trig t = trig_of(x);
   const Eigen::Matrix3d r = body_to_world(t);
-  const MotionJacobian j = jacobian_with(t, r, x, dt);
-  predict_with(t, r, x, dt);
+  const Eigen::Vector3d step = world_step(r, x, dt);
+  const MotionJacobian j = jacobian_with(t, r, step, x, dt);
+  predict_with(t, step, x, dt);
   return j;
 }
 
