@@ -52,7 +52,9 @@ class Ekf {
  private:
   template <int N>
   CorrectResult correct_fixed(const Measurement& m, const int* idx) noexcept;
+  // The update's epilogue: mirror, then cap.
   void condition_covariance() noexcept;
+  void mirror_upper_triangle() noexcept;
   void cap_variances() noexcept;
 
   StateVector x_ = StateVector::Zero();
