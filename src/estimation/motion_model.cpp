@@ -29,11 +29,11 @@ Eigen::Matrix3d body_to_world(const Trig& t) noexcept {
   return r;
 }
 
-// The position step in the world frame, R (v dt + a dt^2 / 2): the motion
-// model moves the position by it, and the Jacobian's attitude columns are
-// cross products with it, so both take it from here.
-Eigen::Vector3d world_step(const Eigen::Matrix3d& r, const StateVector& x, double dt) noexcept {
-  return r * (x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx));
+// The position step in the body frame, v dt + a dt^2 / 2. R times it moves
+// the position, and the Jacobian's attitude columns are cross products with
+// both, so the callers compute it once.
+Eigen::Vector3d body_step(const StateVector& x, double dt) noexcept {
+  return x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx);
 }
 
 void predict_with(const Trig& t, const Eigen::Vector3d& step, StateVector& x, double dt) noexcept {
@@ -48,9 +48,9 @@ void predict_with(const Trig& t, const Eigen::Vector3d& step, StateVector& x, do
   x.segment<3>(kVx) += x.segment<3>(kAx) * dt;
 }
 
-MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const Eigen::Vector3d& step,
-                             const StateVector& x, double dt) noexcept {
-  const Eigen::Vector3d s = x.segment<3>(kVx) * dt + 0.5 * dt * dt * x.segment<3>(kAx);
+// s is body_step(x, dt), step = R s.
+MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const Eigen::Vector3d& s,
+                             const Eigen::Vector3d& step, const StateVector& x, double dt) noexcept {
   const double vp = x(kVpitch), vy = x(kVyaw);
   const double tp = t.sp / t.cp;
   const double sec2 = 1.0 / (t.cp * t.cp);
@@ -87,20 +87,22 @@ MotionJacobian jacobian_with(const Trig& t, const Eigen::Matrix3d& r, const Eige
 
 void motion_model_predict(StateVector& x, double dt) noexcept {
   const Trig t = trig_of(x);
-  predict_with(t, world_step(body_to_world(t), x, dt), x, dt);
+  predict_with(t, body_to_world(t) * body_step(x, dt), x, dt);
 }
 
 MotionJacobian motion_model_jacobian(const StateVector& x, double dt) noexcept {
   const Trig t = trig_of(x);
   const Eigen::Matrix3d r = body_to_world(t);
-  return jacobian_with(t, r, world_step(r, x, dt), x, dt);
+  const Eigen::Vector3d s = body_step(x, dt);
+  return jacobian_with(t, r, s, r * s, x, dt);
 }
 
 MotionJacobian motion_model_step(StateVector& x, double dt) noexcept {
   const Trig t = trig_of(x);
   const Eigen::Matrix3d r = body_to_world(t);
-  const Eigen::Vector3d step = world_step(r, x, dt);
-  const MotionJacobian j = jacobian_with(t, r, step, x, dt);
+  const Eigen::Vector3d s = body_step(x, dt);
+  const Eigen::Vector3d step = r * s;
+  const MotionJacobian j = jacobian_with(t, r, s, step, x, dt);
   predict_with(t, step, x, dt);
   return j;
 }

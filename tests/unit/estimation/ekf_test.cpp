@@ -181,6 +181,58 @@ TEST(Ekf, PredictCovarianceEqualsDenseTripleProduct) {
   EXPECT_LT((ekf.state() - x_expected).cwiseAbs().maxCoeff(), 1e-15);
 }
 
+// The dense-Q path of the predict, with the dynamic scaling of the pose
+// block: F P F' + Q dt, Q's pose block times |twist|^2, P exactly symmetric.
+TEST(Ekf, PredictWithDenseDynamicNoiseEqualsDenseTripleProduct) {
+  std::mt19937 rng(23);
+  std::uniform_real_distribution<double> u(-1.0, 1.0);
+  StateVector x;
+  for (int i = 0; i < kStateSize; ++i) x(i) = u(rng);
+  const StateMatrix p = random_spd(rng);
+  const StateMatrix q = random_spd(rng) * 0.1;
+  const double dt = 0.02;
+
+  Ekf ekf;
+  ekf.set_state(x);
+  ekf.set_covariance(p);
+  ekf.set_process_noise(q);
+  ekf.set_dynamic_process_noise(true);
+  ekf.predict(dt);
+
+  StateVector x_next = x;
+  motion_model_predict(x_next, dt);
+  const double speed2 = x_next.segment<6>(kVx).squaredNorm();
+  StateMatrix scaled_q = q * dt;
+  scaled_q.topLeftCorner<6, 6>() *= speed2;
+  const StateMatrix f = motion_model_jacobian_dense(x, dt);
+  const StateMatrix expected = f * p * f.transpose() + scaled_q;
+  EXPECT_LT((ekf.covariance() - expected).cwiseAbs().maxCoeff(), 1e-12);
+  EXPECT_EQ(ekf.covariance(), ekf.covariance().transpose());
+}
+
+// Outside covariances (set_pose, a first measurement, a config) may be
+// asymmetric by rounding or by mistake; the filter takes the upper triangle.
+TEST(Ekf, CovarianceAndNoiseAreTakenFromTheUpperTriangle) {
+  std::mt19937 rng(29);
+  StateMatrix p = random_spd(rng);
+  StateMatrix q = random_spd(rng) * 0.1;
+  const auto from_upper = [](const StateMatrix& m) {
+    StateMatrix s = m;
+    s.triangularView<Eigen::StrictlyLower>() = m.transpose();
+    return s;
+  };
+  const StateMatrix p_upper = from_upper(p), q_upper = from_upper(q);
+  p(7, 2) += 0.5;  // lower triangle only
+  q(11, 0) -= 0.25;
+  Ekf ekf;
+  ekf.set_covariance(p);
+  EXPECT_EQ(ekf.covariance(), p_upper);
+  ekf.set_process_noise(q);
+  ekf.set_covariance(StateMatrix::Zero());
+  ekf.predict(1.0);  // F 0 F' = 0: P is Q dt
+  EXPECT_EQ(ekf.covariance(), q_upper);
+}
+
 TEST(Ekf, ConstantVelocityMotionInTheBodyFrame) {
   // Heading 90 degrees, 1 m/s forward in the body frame: moves along +y.
   Ekf ekf;
