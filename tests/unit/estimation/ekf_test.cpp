@@ -12,6 +12,7 @@
 #include "estimation/motion_model.hpp"
 #include "support/alloc_counter.hpp"
 #include "support/random_fusion_subset.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::est {
 namespace {
@@ -354,16 +355,11 @@ TEST(Ekf, PredictAndCorrectDoNotAllocate) {
   ekf.set_covariance(StateMatrix::Identity());
   StateVector z = StateVector::Constant(0.1);
   test::AllocScope scope;
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(false);
-#endif
+  test::EigenMallocForbidden eigen_no_malloc;
   for (int size = 1; size <= kStateSize; ++size) {
     ekf.predict(0.01);
     ekf.correct(measure(static_cast<UpdateMask>((1u << size) - 1u), z, 0.5));
   }
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(true);
-#endif
   EXPECT_EQ(scope.count(), 0u);
 }
 

@@ -9,6 +9,7 @@
 
 #include "geometry/rotation.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::est {
 namespace {
@@ -276,12 +277,11 @@ TEST(NavsatTransform, ConvertAllocatesNothing) {
   const NavSatFixSample a = fix_at(0, 0);
   const NavSatFixSample b = fix_at(500, 0);
   test::AllocScope scope;
-  Eigen::internal::set_is_malloc_allowed(false);
+  test::EigenMallocForbidden eigen_no_malloc;
   for (int i = 0; i < 100; ++i) {
     nt.convert(i * kSecond / 5, i % 7 == 3 ? b : a, pose(0, 0, 0), &out);
     (void)nt.filtered_fix(out.position, out.covariance.topLeftCorner<3, 3>());
   }
-  Eigen::internal::set_is_malloc_allowed(true);
   EXPECT_EQ(scope.count(), 0u);
   EXPECT_GT(nt.stats().jumps, 0);
 }

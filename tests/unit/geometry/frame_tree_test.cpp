@@ -6,6 +6,7 @@
 
 #include "geometry/angles.hpp"
 #include "geometry/rotation.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::test {
 std::uint64_t allocation_count() noexcept;
@@ -148,9 +149,7 @@ TEST_F(GeometryFrameTree, FindInternAndName) {
 TEST_F(GeometryFrameTree, FindAndLookupDoNotAllocate) {
   const int imu = tree.find("imu_link");
   const int map = tree.find("map");
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(false);
-#endif
+  test::EigenMallocForbidden eigen_no_malloc;
   const std::uint64_t before = rtfuse::test::allocation_count();
   double sum = 0;
   int found = 0;
@@ -162,9 +161,6 @@ TEST_F(GeometryFrameTree, FindAndLookupDoNotAllocate) {
     sum += t->translation.x() + u->translation.y();
   }
   const std::uint64_t after = rtfuse::test::allocation_count();
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(true);
-#endif
   EXPECT_EQ(after, before);
   EXPECT_EQ(found, 100);
   EXPECT_TRUE(std::isfinite(sum));

@@ -6,6 +6,7 @@
 
 #include "core/spsc_ring.hpp"
 #include "geometry/rigid_transform.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::test {
 std::uint64_t allocation_count() noexcept;
@@ -24,9 +25,7 @@ TEST(GeometrySpscRingEigenPayload, PushPopWithoutAnyAllocation) {
   rtfuse::SpscRing<Sample> ring(5);
   Sample in;
   Sample out;
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(false);
-#endif
+  test::EigenMallocForbidden eigen_no_malloc;
   const std::uint64_t before = rtfuse::test::allocation_count();
   bool ok = true;
   for (std::int64_t i = 0; i < 100; ++i) {
@@ -43,9 +42,6 @@ TEST(GeometrySpscRingEigenPayload, PushPopWithoutAnyAllocation) {
           out.covariance(5, 5) == static_cast<double>(i);
   }
   const std::uint64_t after = rtfuse::test::allocation_count();
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(true);
-#endif
   EXPECT_TRUE(ok);
   EXPECT_EQ(after, before);
 }

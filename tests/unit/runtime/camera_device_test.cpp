@@ -1,7 +1,7 @@
 // The camera thread device on a MockVideoStream: its diagnostics slot says
 // what the driver counted, the digest of the published pairs, and the last
 // error in words ("" until there is one, kept after the camera recovers).
-#include "runtime/camera_device.hpp"
+#include "runtime/devices/camera/camera_device.hpp"
 
 #include <gtest/gtest.h>
 
@@ -13,8 +13,8 @@
 #include "hal/mock/frame_source.hpp"
 #include "hal/mock/mock_video_stream.hpp"
 #include "hal/mock/sim_clock.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/device_layout.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/devices/device_layout.hpp"
 
 namespace rtfuse {
 namespace {

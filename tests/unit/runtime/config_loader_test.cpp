@@ -1,4 +1,4 @@
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 
 #include <cmath>
 #include <limits>

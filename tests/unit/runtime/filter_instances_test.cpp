@@ -16,9 +16,9 @@
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/tf_t.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/publisher.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/pipeline/publisher.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse {

@@ -1,6 +1,6 @@
 // FusionCore through its real input path: encoded LCM messages -> InputRouter
 // -> rings -> tick -> snapshot.
-#include "runtime/fusion_core.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 
 #include <cmath>
 #include <vector>
@@ -10,7 +10,7 @@
 #include "geometry/rotation.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse {

@@ -1,7 +1,7 @@
 // The GNSS receiver as a thread device on the mock serial port: fixes into
 // the navsat sensor's ring at their epoch, health into diagnostics, and a
 // receiver that is unplugged and comes back.
-#include "runtime/gnss_device.hpp"
+#include "runtime/devices/gnss/gnss_device.hpp"
 
 #include <string>
 #include <vector>
@@ -10,7 +10,7 @@
 
 #include "hal/mock/mock_serial_port.hpp"
 #include "hal/mock/sim_clock.hpp"
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 #include "support/alloc_counter.hpp"
 #include "support/gnss_bytes.hpp"
 

@@ -5,7 +5,7 @@
 
 #include <gtest/gtest.h>
 
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 
 namespace rtfuse {
 namespace {

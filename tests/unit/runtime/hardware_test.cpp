@@ -3,7 +3,7 @@
 // step (MPU): what they measure reaches the estimate, their health reaches
 // the snapshot's devices, faults show and recover, and the steady state
 // allocates nothing.
-#include "runtime/hardware.hpp"
+#include "runtime/devices/hardware.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -18,9 +18,10 @@
 #include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/scripted_gpio.hpp"
 #include "hal/mock/sim_clock.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/hal_replay.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/replay/hal_replay.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse {
 namespace {
@@ -364,15 +365,10 @@ TEST(Hardware, SteadyStateTicksAllocateNothing) {
   const std::int64_t accepted = rig.snap().sensors[0].accepted;
   std::size_t allocations = 0;
   {
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(false);
-#endif
+    test::EigenMallocForbidden eigen_no_malloc;
     test::AllocScope scope;
     rig.run(2000);
     allocations = scope.count();
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(true);
-#endif
   }
   EXPECT_EQ(allocations, 0u);
   // The work was done: 2000 twists fused, 2000 SYNCs sent.
@@ -504,15 +500,10 @@ TEST(Hardware, ImuStepAllocatesNothingInSteadyState) {
   int samples = 0;
   std::size_t allocations = 0;
   {
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(false);
-#endif
+    test::EigenMallocForbidden eigen_no_malloc;
     test::AllocScope scope;
     for (int i = 0; i < 1000; ++i) samples += rig.step(0.3) == drivers::StepResult::kSample;
     allocations = scope.count();
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(true);
-#endif
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_EQ(samples, 1000);

@@ -13,9 +13,9 @@
 #include "rtfuse/imu_t.hpp"
 #include "rtfuse/navsat_fix_t.hpp"
 #include "rtfuse/odometry_t.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/device_layout.hpp"
-#include "runtime/fusion_core.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse {

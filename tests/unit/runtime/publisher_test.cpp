@@ -1,5 +1,5 @@
-#include "runtime/publisher.hpp"
-#include "runtime/device_layout.hpp"
+#include "runtime/pipeline/publisher.hpp"
+#include "runtime/devices/device_layout.hpp"
 
 #include <gtest/gtest.h>
 
@@ -15,6 +15,7 @@
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/tf_t.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse {
 namespace {
@@ -298,9 +299,7 @@ TEST(Publisher, SteadyStatePollNeverAllocates) {
 
   std::size_t allocations = 0;
   {
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(false);
-#endif
+    test::EigenMallocForbidden eigen_no_malloc;
     test::AllocScope scope;
     for (int i = 10; i < 5000; ++i) {
       s.state[0] = 0.001 * i;
@@ -308,9 +307,6 @@ TEST(Publisher, SteadyStatePollNeverAllocates) {
       pub.poll(s, i * kMs, sink);
     }
     allocations = scope.count();
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(true);
-#endif
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_GT(sink.messages, 1000);

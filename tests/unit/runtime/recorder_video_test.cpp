@@ -13,7 +13,7 @@
 #include "hal/recording_can_bus.hpp"
 #include "hal/recording_video_stream.hpp"
 #include "hal/replay/replay_video_stream.hpp"
-#include "runtime/recorder.hpp"
+#include "runtime/pipeline/recorder.hpp"
 #include "support/temp_file.hpp"
 
 namespace rtfuse::runtime {

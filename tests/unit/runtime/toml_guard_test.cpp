@@ -2,15 +2,15 @@
 // 3.3.0 aborts on never reaches it, the whitespace table it misreads is
 // mended, and valid TOML passes untouched (issue 11, defect 6). The test build keeps assertions on, so a header
 // that slipped through would abort this test.
-#include "runtime/toml_guard.hpp"
+#include "runtime/config/toml_guard.hpp"
 
 #include <gtest/gtest.h>
 
 #include <string>
 #include <vector>
 
-#include "runtime/config_loader.hpp"
-#include "runtime/toml_reader.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/config/toml_reader.hpp"
 
 namespace rtfuse::config {
 namespace {

@@ -16,8 +16,8 @@
 #include <gtest/gtest.h>
 
 #include "geometry/rotation.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/fusion_core.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 
 namespace rtfuse {
 namespace {

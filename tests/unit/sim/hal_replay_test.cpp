@@ -3,7 +3,7 @@
 // reported (a different sent frame: divergence at its log event; a
 // different byte read: outputs that differ, named), and a replay with
 // another configuration is refused with both hashes.
-#include "runtime/hal_replay.hpp"
+#include "runtime/replay/hal_replay.hpp"
 
 #include <unistd.h>
 
@@ -17,8 +17,8 @@
 
 #include <gtest/gtest.h>
 
-#include "runtime/config_loader.hpp"
-#include "runtime/recording_tap.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/pipeline/recording_tap.hpp"
 #include "sim/simulated_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"

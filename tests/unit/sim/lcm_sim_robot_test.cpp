@@ -12,6 +12,7 @@
 #include "rtfuse/imu_t.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::sim {
 namespace {
@@ -308,9 +309,7 @@ TEST(LcmSimRobot, NextDueNeverAllocates) {
   long messages = 0, empty = 0;
   std::size_t allocations = 0;
   {
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(false);
-#endif
+    test::EigenMallocForbidden eigen_no_malloc;
     test::AllocScope scope;
     for (; now < kStart + 60 * kSec; now += 5'000'000) {
       while (robot.next_due(now, &m)) {
@@ -319,9 +318,6 @@ TEST(LcmSimRobot, NextDueNeverAllocates) {
       }
     }
     allocations = scope.count();
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-    Eigen::internal::set_is_malloc_allowed(true);
-#endif
   }
   EXPECT_EQ(allocations, 0u);
   EXPECT_GT(messages, 11000);

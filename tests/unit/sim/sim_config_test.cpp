@@ -8,8 +8,8 @@
 
 #include "geometry/rotation.hpp"
 #include "rtfuse/odometry_t.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/fusion_core.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 #include "sim/lcm_sim_robot.hpp"
 
 namespace rtfuse::sim {

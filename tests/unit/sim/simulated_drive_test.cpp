@@ -17,7 +17,7 @@
 
 #include <gtest/gtest.h>
 
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 #include "support/sim_toml.hpp"
 
 namespace rtfuse::sim {

@@ -15,24 +15,20 @@
 #include "transport/encode_buffer.hpp"
 #include "transport/event_log.hpp"
 #include "transport/sample_decoder.hpp"
+#include "support/eigen_no_malloc.hpp"
 
 namespace {
 
 // Counts allocations made inside f, with Eigen's own check armed as well.
 template <class F>
 long allocations_in(F&& f) {
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(false);
-#endif
+  test::EigenMallocForbidden eigen_no_malloc;
   long n = 0;
   {
     rtfuse::test::AllocScope scope;
     f();
     n = static_cast<long>(scope.count());
   }
-#ifdef EIGEN_RUNTIME_NO_MALLOC
-  Eigen::internal::set_is_malloc_allowed(true);
-#endif
   return n;
 }
 

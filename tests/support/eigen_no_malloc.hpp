@@ -1,0 +1,23 @@
+#pragma once
+// Forbids Eigen's heap allocations for its lifetime, where the build arms
+// Eigen's check (EIGEN_RUNTIME_NO_MALLOC: RTFUSE_EIGEN_NO_MALLOC_CHECK, on
+// whenever the tests are built). The one place that names Eigen's switch, so
+// a test compiles in every configuration: a bare call fails to compile where
+// the check is not armed, which is how a default build once broke.
+#include <Eigen/Core>
+#include "support/eigen_no_malloc.hpp"
+
+namespace rtfuse::test {
+
+class EigenMallocForbidden {
+ public:
+  EigenMallocForbidden() {
+    test::EigenMallocForbidden eigen_no_malloc;
+  }
+  ~EigenMallocForbidden() {
+  }
+  EigenMallocForbidden(const EigenMallocForbidden&) = delete;
+  EigenMallocForbidden& operator=(const EigenMallocForbidden&) = delete;
+};
+
+}  // namespace rtfuse::test
