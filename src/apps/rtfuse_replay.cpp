@@ -15,9 +15,9 @@
 
 #include <CLI/CLI.hpp>
 
-#include "runtime/config_loader.hpp"
-#include "runtime/hal_replay.hpp"
-#include "runtime/replay.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/replay/hal_replay.hpp"
+#include "runtime/replay/replay.hpp"
 #include "transport/hal_record_codec.hpp"
 
 namespace {

@@ -23,7 +23,7 @@
 
 #include <CLI/CLI.hpp>
 
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 #include "sim/simulated_drive.hpp"
 
 extern "C" void rtfuse_alloc_probe_steady(int steady) __attribute__((weak));

@@ -19,12 +19,12 @@
 #include <CLI/CLI.hpp>
 
 #include "hal/linux/monotonic_clock.hpp"
-#include "runtime/camera_calibration.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/linux_hal.hpp"
-#include "runtime/loop_timer.hpp"
-#include "runtime/realtime.hpp"
-#include "runtime/runtime.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/devices/linux_hal.hpp"
+#include "runtime/live/loop_timer.hpp"
+#include "runtime/live/realtime.hpp"
+#include "runtime/live/runtime.hpp"
 #include "sim/ground_truth.hpp"
 #include "sim/lcm_sim_robot.hpp"
 #include "sim/simulated_robot.hpp"

@@ -7,7 +7,7 @@
 #include <limits>
 #include <optional>
 
-#include "runtime/toml_reader.hpp"
+#include "runtime/config/toml_reader.hpp"
 #include "sim/path_plan.hpp"
 
 namespace rtfuse::sim {

@@ -9,7 +9,7 @@
 #include <memory>
 
 #include "core/time.hpp"
-#include "runtime/config.hpp"
+#include "runtime/config/config.hpp"
 
 namespace rtfuse::sim {
 

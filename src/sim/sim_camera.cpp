@@ -4,7 +4,7 @@
 
 #include "drivers/camera/camera_modes.hpp"
 #include "geometry/frame_tree.hpp"
-#include "runtime/camera_calibration.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
 
 namespace rtfuse::sim {
 

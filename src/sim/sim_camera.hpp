@@ -13,7 +13,7 @@
 #include "hal/clock.hpp"
 #include "hal/mock/frame_source.hpp"
 #include "hal/mock/mock_video_stream.hpp"
-#include "runtime/config.hpp"
+#include "runtime/config/config.hpp"
 #include "sim/camera_world.hpp"
 #include "sim/stereo_renderer.hpp"
 #include "sim/truth_trajectory.hpp"

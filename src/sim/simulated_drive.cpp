@@ -11,7 +11,7 @@
 #include <thread>
 
 #include "hal/mock/sim_clock.hpp"
-#include "runtime/tick_pipeline.hpp"
+#include "runtime/pipeline/tick_pipeline.hpp"
 #include "sim/ground_truth.hpp"
 #include "sim/simulated_robot.hpp"
 

@@ -9,8 +9,8 @@
 #include <functional>
 #include <string>
 
-#include "runtime/config.hpp"
-#include "runtime/snapshot.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/fusion/snapshot.hpp"
 #include "sim/truth_trajectory.hpp"
 
 namespace rtfuse::sim {

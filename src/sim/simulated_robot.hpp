@@ -11,8 +11,8 @@
 
 #include "hal/clock.hpp"
 #include "rtfuse/odometry_t.hpp"
-#include "runtime/config.hpp"
-#include "runtime/hal_buses.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/devices/hal_buses.hpp"
 #include "sim/drive_scenario.hpp"
 #include "sim/sim_camera.hpp"
 #include "sim/sim_encoders.hpp"

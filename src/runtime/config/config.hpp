@@ -9,7 +9,7 @@
 #include "core/fixed_string.hpp"
 #include "estimation/filter_params.hpp"
 #include "geometry/rigid_transform.hpp"
-#include "runtime/hardware_config.hpp"
+#include "runtime/config/hardware_config.hpp"
 
 namespace rtfuse {
 

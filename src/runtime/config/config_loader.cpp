@@ -1,4 +1,4 @@
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 
 #include <algorithm>
 #include <array>
@@ -15,8 +15,8 @@
 #include <vector>
 
 #include "geometry/rotation.hpp"
-#include "runtime/hardware_config_loader.hpp"
-#include "runtime/toml_reader.hpp"
+#include "runtime/config/hardware_config_loader.hpp"
+#include "runtime/config/toml_reader.hpp"
 
 namespace rtfuse {
 namespace {

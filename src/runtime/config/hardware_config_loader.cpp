@@ -1,4 +1,4 @@
-#include "runtime/hardware_config_loader.hpp"
+#include "runtime/config/hardware_config_loader.hpp"
 
 #include <filesystem>
 #include <string>

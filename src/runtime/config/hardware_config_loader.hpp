@@ -4,7 +4,7 @@
 #include <string>
 #include <vector>
 
-#include "runtime/toml_reader.hpp"
+#include "runtime/config/toml_reader.hpp"
 
 namespace rtfuse::config {
 

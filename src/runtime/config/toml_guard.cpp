@@ -1,4 +1,4 @@
-#include "runtime/toml_guard.hpp"
+#include "runtime/config/toml_guard.hpp"
 
 #include <cstdio>
 

@@ -1,6 +1,6 @@
-#include "runtime/toml_reader.hpp"
+#include "runtime/config/toml_reader.hpp"
 
-#include "runtime/toml_guard.hpp"
+#include "runtime/config/toml_guard.hpp"
 
 #include <algorithm>
 #include <iomanip>

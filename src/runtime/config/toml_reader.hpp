@@ -15,11 +15,11 @@
 #include <utility>
 #include <vector>
 
-#include "runtime/toml.hpp"
+#include "runtime/config/toml.hpp"
 
 #include "estimation/state.hpp"
-#include "runtime/config.hpp"
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/config/config_loader.hpp"
 
 namespace rtfuse::config {
 

@@ -1,4 +1,4 @@
-#include "runtime/device_layout.hpp"
+#include "runtime/devices/device_layout.hpp"
 
 #include <cstdio>
 

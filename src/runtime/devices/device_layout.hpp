@@ -4,8 +4,8 @@
 // and the loop fills the same slots every tick (runtime/hardware.cpp).
 #include <initializer_list>
 
-#include "runtime/config.hpp"
-#include "runtime/device_status.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/fusion/device_status.hpp"
 
 namespace rtfuse {
 

@@ -1,4 +1,4 @@
-#include "runtime/hardware.hpp"
+#include "runtime/devices/hardware.hpp"
 
 namespace rtfuse {
 

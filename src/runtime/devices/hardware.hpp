@@ -11,14 +11,14 @@
 #include <memory>
 #include <string>
 
-#include "runtime/camera_device.hpp"
-#include "runtime/device_layout.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/gnss_device.hpp"
-#include "runtime/hal_buses.hpp"
-#include "runtime/imu_device.hpp"
-#include "runtime/thread_device.hpp"
-#include "runtime/wheel_encoder_device.hpp"
+#include "runtime/devices/camera/camera_device.hpp"
+#include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/devices/gnss/gnss_device.hpp"
+#include "runtime/devices/hal_buses.hpp"
+#include "runtime/devices/imu/imu_device.hpp"
+#include "runtime/devices/thread_device.hpp"
+#include "runtime/devices/wheel_encoders/wheel_encoder_device.hpp"
 
 namespace rtfuse {
 

@@ -1,4 +1,4 @@
-#include "runtime/linux_hal.hpp"
+#include "runtime/devices/linux_hal.hpp"
 
 #include "drivers/camera/camera_modes.hpp"
 #include "drivers/camera/zed_usb_hint.hpp"

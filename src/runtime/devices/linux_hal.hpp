@@ -6,8 +6,8 @@
 #include <memory>
 #include <string>
 
-#include "runtime/config.hpp"
-#include "runtime/hal_buses.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/devices/hal_buses.hpp"
 
 namespace rtfuse {
 

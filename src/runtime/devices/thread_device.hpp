@@ -8,7 +8,7 @@
 #include <cstdint>
 
 #include "core/time.hpp"
-#include "runtime/snapshot.hpp"
+#include "runtime/fusion/snapshot.hpp"
 
 namespace rtfuse {
 

@@ -1,4 +1,4 @@
-#include "runtime/fusion_core.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 
 #include <cmath>
 #include <cstdio>

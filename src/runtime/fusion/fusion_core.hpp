@@ -8,10 +8,10 @@
 #include "estimation/filter.hpp"
 #include "estimation/sensor_model.hpp"
 #include "geometry/frame_tree.hpp"
-#include "runtime/config.hpp"
-#include "runtime/device_layout.hpp"
-#include "runtime/input_router.hpp"
-#include "runtime/snapshot.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/input_router.hpp"
+#include "runtime/fusion/snapshot.hpp"
 
 namespace rtfuse {
 

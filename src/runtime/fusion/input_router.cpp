@@ -1,4 +1,4 @@
-#include "runtime/input_router.hpp"
+#include "runtime/fusion/input_router.hpp"
 
 #include <cmath>
 #include <cstring>

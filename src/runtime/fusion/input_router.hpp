@@ -8,7 +8,7 @@
 
 #include "core/spsc_ring.hpp"
 #include "estimation/sensor_sample.hpp"
-#include "runtime/config.hpp"
+#include "runtime/config/config.hpp"
 #include "transport/sample_decoder.hpp"
 
 namespace rtfuse {

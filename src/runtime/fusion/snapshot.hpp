@@ -3,8 +3,8 @@
 // a SeqLock: plain arrays only, so it is trivially copyable.
 #include <cstdint>
 
-#include "runtime/config.hpp"
-#include "runtime/device_status.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/fusion/device_status.hpp"
 
 namespace rtfuse {
 

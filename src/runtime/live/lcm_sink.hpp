@@ -1,6 +1,6 @@
 #pragma once
 // Publisher output straight onto LCM (lcm_publish from the caller's buffer).
-#include "runtime/publisher.hpp"
+#include "runtime/pipeline/publisher.hpp"
 #include "transport/lcm_node.hpp"
 
 namespace rtfuse {

@@ -1,4 +1,4 @@
-#include "runtime/loop_timer.hpp"
+#include "runtime/live/loop_timer.hpp"
 
 #include <cerrno>
 #include <cmath>

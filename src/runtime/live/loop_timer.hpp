@@ -4,7 +4,7 @@
 #include <cstdint>
 
 #include "core/time.hpp"
-#include "runtime/snapshot.hpp"
+#include "runtime/fusion/snapshot.hpp"
 
 namespace rtfuse {
 

@@ -1,4 +1,4 @@
-#include "runtime/realtime.hpp"
+#include "runtime/live/realtime.hpp"
 
 #include <pthread.h>
 #include <sched.h>

@@ -5,7 +5,7 @@
 
 #include <string>
 
-#include "runtime/config.hpp"
+#include "runtime/config/config.hpp"
 
 namespace rtfuse {
 

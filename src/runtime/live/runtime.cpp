@@ -1,12 +1,12 @@
-#include "runtime/runtime.hpp"
+#include "runtime/live/runtime.hpp"
 
 #include <algorithm>
 #include <atomic>
 #include <cstdio>
 
-#include "runtime/lcm_sink.hpp"
-#include "runtime/loop_timer.hpp"
-#include "runtime/realtime.hpp"
+#include "runtime/live/lcm_sink.hpp"
+#include "runtime/live/loop_timer.hpp"
+#include "runtime/live/realtime.hpp"
 
 namespace rtfuse {
 

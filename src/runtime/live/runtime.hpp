@@ -17,9 +17,9 @@
 
 #include "core/spsc_ring.hpp"
 #include "hal/linux/monotonic_clock.hpp"
-#include "runtime/camera_outputs.hpp"
-#include "runtime/hal_buses.hpp"
-#include "runtime/tick_pipeline.hpp"
+#include "runtime/devices/camera/camera_outputs.hpp"
+#include "runtime/devices/hal_buses.hpp"
+#include "runtime/pipeline/tick_pipeline.hpp"
 #include "transport/lcm_node.hpp"
 
 namespace rtfuse {

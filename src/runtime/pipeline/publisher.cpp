@@ -1,4 +1,4 @@
-#include "runtime/publisher.hpp"
+#include "runtime/pipeline/publisher.hpp"
 
 #include <array>
 #include <cmath>
@@ -6,7 +6,7 @@
 #include <vector>
 
 #include "geometry/rotation.hpp"
-#include "runtime/device_layout.hpp"
+#include "runtime/devices/device_layout.hpp"
 #include "rtfuse/diagnostics_t.hpp"
 #include "rtfuse/filter_state_t.hpp"
 #include "rtfuse/navsat_fix_t.hpp"

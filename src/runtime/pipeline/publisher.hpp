@@ -12,8 +12,8 @@
 #include <memory>
 
 #include "core/time.hpp"
-#include "runtime/config.hpp"
-#include "runtime/snapshot.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/fusion/snapshot.hpp"
 
 namespace rtfuse {
 

@@ -1,4 +1,4 @@
-#include "runtime/recorder.hpp"
+#include "runtime/pipeline/recorder.hpp"
 
 #include <pthread.h>
 

@@ -35,8 +35,8 @@
 #include "core/time.hpp"
 #include "hal/bus_event.hpp"
 #include "hal/video_event.hpp"
-#include "runtime/config.hpp"
-#include "runtime/publisher.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/pipeline/publisher.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
 

@@ -1,8 +1,8 @@
-#include "runtime/recording_tap.hpp"
+#include "runtime/pipeline/recording_tap.hpp"
 
 #include <algorithm>
 
-#include "runtime/camera_calibration.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
 
 namespace rtfuse {
 namespace {

@@ -19,9 +19,9 @@
 #include "hal/recording_i2c_bus.hpp"
 #include "hal/recording_serial_port.hpp"
 #include "hal/recording_video_stream.hpp"
-#include "runtime/config.hpp"
-#include "runtime/hal_buses.hpp"
-#include "runtime/recorder.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/devices/hal_buses.hpp"
+#include "runtime/pipeline/recorder.hpp"
 
 namespace rtfuse {
 

@@ -1,6 +1,6 @@
-#include "runtime/tick_pipeline.hpp"
+#include "runtime/pipeline/tick_pipeline.hpp"
 
-#include "runtime/camera_calibration.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
 
 namespace rtfuse {
 

@@ -11,11 +11,11 @@
 #include <string>
 
 #include "hal/clock.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/hal_buses.hpp"
-#include "runtime/hardware.hpp"
-#include "runtime/publisher.hpp"
-#include "runtime/recording_tap.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/devices/hal_buses.hpp"
+#include "runtime/devices/hardware.hpp"
+#include "runtime/pipeline/publisher.hpp"
+#include "runtime/pipeline/recording_tap.hpp"
 
 namespace rtfuse {
 

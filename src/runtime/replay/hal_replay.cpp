@@ -1,4 +1,4 @@
-#include "runtime/hal_replay.hpp"
+#include "runtime/replay/hal_replay.hpp"
 
 #include <algorithm>
 #include <cstdio>
@@ -12,9 +12,9 @@
 #include "hal/replay/replay_i2c_bus.hpp"
 #include "hal/replay/replay_serial_port.hpp"
 #include "hal/replay/replay_video_stream.hpp"
-#include "runtime/camera_calibration.hpp"
-#include "runtime/recording_tap.hpp"
-#include "runtime/tick_pipeline.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
+#include "runtime/pipeline/recording_tap.hpp"
+#include "runtime/pipeline/tick_pipeline.hpp"
 
 namespace rtfuse {
 namespace {

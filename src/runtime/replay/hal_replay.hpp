@@ -14,8 +14,8 @@
 #include <memory>
 #include <string>
 
-#include "runtime/config.hpp"
-#include "runtime/snapshot.hpp"
+#include "runtime/config/config.hpp"
+#include "runtime/fusion/snapshot.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
 

@@ -1,4 +1,4 @@
-#include "runtime/replay.hpp"
+#include "runtime/replay/replay.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -8,8 +8,8 @@
 #include <memory>
 #include <string>
 
-#include "runtime/fusion_core.hpp"
-#include "runtime/publisher.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/pipeline/publisher.hpp"
 #include "transport/event_log.hpp"
 
 namespace rtfuse {

@@ -1,4 +1,4 @@
-#include "runtime/camera_calibration.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
 
 namespace rtfuse {
 

@@ -8,7 +8,7 @@
 #include <string>
 
 #include "drivers/camera/zed_calibration.hpp"
-#include "runtime/hardware_config.hpp"
+#include "runtime/config/hardware_config.hpp"
 
 namespace rtfuse {
 

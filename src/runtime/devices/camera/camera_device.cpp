@@ -1,10 +1,10 @@
-#include "runtime/camera_device.hpp"
+#include "runtime/devices/camera/camera_device.hpp"
 
 #include <algorithm>
 #include <cmath>
 #include <cstdio>
 
-#include "runtime/camera_calibration.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
 
 namespace rtfuse {
 

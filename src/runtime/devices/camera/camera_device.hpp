@@ -18,11 +18,11 @@
 #include "core/frame_pool.hpp"
 #include "core/seqlock.hpp"
 #include "drivers/camera/stereo_camera.hpp"
-#include "runtime/device_layout.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/hal_buses.hpp"
-#include "runtime/thread_device.hpp"
-#include "runtime/visual_odometry.hpp"
+#include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/devices/hal_buses.hpp"
+#include "runtime/devices/thread_device.hpp"
+#include "runtime/devices/visual_odometry/visual_odometry.hpp"
 
 namespace rtfuse {
 

@@ -1,4 +1,4 @@
-#include "runtime/camera_outputs.hpp"
+#include "runtime/devices/camera/camera_outputs.hpp"
 
 #include <cmath>
 

@@ -9,8 +9,8 @@
 #include <memory>
 #include <string>
 
-#include "runtime/camera_device.hpp"
-#include "runtime/publisher.hpp"
+#include "runtime/devices/camera/camera_device.hpp"
+#include "runtime/pipeline/publisher.hpp"
 #include "transport/camera_messages.hpp"
 
 namespace rtfuse {

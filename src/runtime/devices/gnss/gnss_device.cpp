@@ -1,4 +1,4 @@
-#include "runtime/gnss_device.hpp"
+#include "runtime/devices/gnss/gnss_device.hpp"
 
 #include <algorithm>
 #include <cmath>

@@ -1,4 +1,4 @@
-#include "runtime/imu_device.hpp"
+#include "runtime/devices/imu/imu_device.hpp"
 
 #include <cmath>
 

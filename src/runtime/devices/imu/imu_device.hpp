@@ -8,10 +8,10 @@
 
 #include "core/seqlock.hpp"
 #include "drivers/imu/mpu_imu.hpp"
-#include "runtime/device_layout.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/hal_buses.hpp"
-#include "runtime/thread_device.hpp"
+#include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/devices/hal_buses.hpp"
+#include "runtime/devices/thread_device.hpp"
 
 namespace rtfuse {
 

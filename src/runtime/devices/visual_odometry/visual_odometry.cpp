@@ -1,4 +1,4 @@
-#include "runtime/visual_odometry.hpp"
+#include "runtime/devices/visual_odometry/visual_odometry.hpp"
 
 #include <algorithm>
 #include <cmath>

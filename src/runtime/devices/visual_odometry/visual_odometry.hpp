@@ -21,7 +21,7 @@
 #include "core/frame_pool.hpp"
 #include "drivers/camera/stereo_rectification.hpp"
 #include "estimation/sensor_sample.hpp"
-#include "runtime/hardware_config.hpp"
+#include "runtime/config/hardware_config.hpp"
 #include "vision/stereo_odometry.hpp"
 
 namespace rtfuse {

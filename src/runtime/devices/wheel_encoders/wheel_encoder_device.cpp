@@ -1,4 +1,4 @@
-#include "runtime/wheel_encoder_device.hpp"
+#include "runtime/devices/wheel_encoders/wheel_encoder_device.hpp"
 
 #include <cmath>
 

@@ -7,8 +7,8 @@
 
 #include "drivers/canopen/canopen_encoders.hpp"
 #include "drivers/wheel/wheel_odometry.hpp"
-#include "runtime/device_layout.hpp"
-#include "runtime/fusion_core.hpp"
+#include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 
 namespace rtfuse {
 
