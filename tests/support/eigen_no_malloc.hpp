@@ -12,9 +12,14 @@ namespace rtfuse::test {
 class EigenMallocForbidden {
  public:
   EigenMallocForbidden() {
-    test::EigenMallocForbidden eigen_no_malloc;
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+    Eigen::internal::set_is_malloc_allowed(false);
+#endif
   }
   ~EigenMallocForbidden() {
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+    Eigen::internal::set_is_malloc_allowed(true);
+#endif
   }
   EigenMallocForbidden(const EigenMallocForbidden&) = delete;
   EigenMallocForbidden& operator=(const EigenMallocForbidden&) = delete;
