@@ -1,63 +1,24 @@
 #include "apps/stereo_png.hpp"
 
 #include <png.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <cerrno>
-#include <csetjmp>
 #include <cstddef>
-#include <cstdio>
 #include <cstring>
-#include <vector>
+
+#include "apps/rgb_png.hpp"
 
 namespace rtfuse::apps {
 namespace {
 
-// What the libpng callbacks report back: they cannot throw or return an
-// error, only longjmp out of libpng.
-struct PngContext {
-  std::FILE* file = nullptr;
-  int write_errno = 0;    // errno of a failed write (ENOSPC, EIO, ...)
-  char message[256] = {};  // libpng's own error text
-};
-
-void on_error(png_structp png, png_const_charp message) {
-  auto* ctx = static_cast<PngContext*>(png_get_error_ptr(png));
-  std::snprintf(ctx->message, sizeof ctx->message, "%s", message != nullptr ? message : "unknown error");
-  png_longjmp(png, 1);
-}
-
-// Warnings (e.g. an unusual but valid setting) do not fail the write.
-void on_warning(png_structp, png_const_charp) {}
-
-// Our own I/O callbacks rather than png_init_io: libpng's say "Write Error"
-// and drop errno, and the caller must be told "No space left on device".
-void on_write(png_structp png, png_bytep data, std::size_t size) {
-  auto* ctx = static_cast<PngContext*>(png_get_io_ptr(png));
-  errno = 0;
-  if (std::fwrite(data, 1, size, ctx->file) != size) {
-    ctx->write_errno = errno != 0 ? errno : EIO;
-    png_error(png, "write failed");
-  }
-}
-
-void on_flush(png_structp png) {
-  auto* ctx = static_cast<PngContext*>(png_get_io_ptr(png));
-  if (std::fflush(ctx->file) != 0) {
-    ctx->write_errno = errno != 0 ? errno : EIO;
-    png_error(png, "flush failed");
-  }
-}
-
-struct Pair {
+struct Picture {
   const std::uint8_t* left;
   const std::uint8_t* right;
   int width, height, stride, guide_every_px;
 };
 
 // One RGB row of the picture: the two eyes as grey, or a guide line.
-void fill_row(const Pair& p, int y, std::uint8_t* row) noexcept {
+void fill_row(const void* context, int y, std::uint8_t* row) noexcept {
+  const Picture& p = *static_cast<const Picture*>(context);
   const int n = 2 * p.width;
   if (p.guide_every_px > 0 && y > 0 && y % p.guide_every_px == 0) {
     for (int x = 0; x < n; ++x) std::memcpy(row + 3 * x, kGuideRgb, 3);
@@ -69,22 +30,6 @@ void fill_row(const Pair& p, int y, std::uint8_t* row) noexcept {
     std::uint8_t* dst = row + 3 * eye * p.width;
     for (int x = 0; x < p.width; ++x) dst[3 * x] = dst[3 * x + 1] = dst[3 * x + 2] = src[x];
   }
-}
-
-// png_error longjmps back to the setjmp here, skipping every frame in
-// between: this function and libpng's frames hold nothing with a destructor
-// (the row buffer belongs to the caller), so nothing is leaked or skipped.
-bool write_rows(png_structp png, png_infop info, const Pair& p, std::uint8_t* row) {
-  if (setjmp(png_jmpbuf(png))) return false;
-  png_set_IHDR(png, info, static_cast<png_uint_32>(2 * p.width), static_cast<png_uint_32>(p.height), 8,
-               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < p.height; ++y) {
-    fill_row(p, y, row);
-    png_write_row(png, row);
-  }
-  png_write_end(png, nullptr);
-  return true;
 }
 
 bool fail(std::string* error, const std::string& message) {
@@ -107,35 +52,8 @@ bool write_stereo_png(const std::string& path, const std::uint8_t* left, const s
     return fail(error, what + "pair " + std::to_string(width) + "x" + std::to_string(height) +
                            " exceeds libpng's limits (" + std::to_string(PNG_USER_WIDTH_MAX) + " px per side)");
 
-  PngContext ctx;
-  ctx.file = std::fopen(path.c_str(), "wb");
-  if (ctx.file == nullptr) return fail(error, "cannot open " + path + ": " + std::strerror(errno));
-
-  std::vector<std::uint8_t> row(static_cast<std::size_t>(width) * 6u);
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  bool ok = false;
-  if (png != nullptr && info != nullptr) {
-    png_set_write_fn(png, &ctx, on_write, on_flush);
-    const Pair pair{left, right, width, height, stride, guide_every_px};
-    ok = write_rows(png, info, pair, row.data());
-  } else {
-    std::snprintf(ctx.message, sizeof ctx.message, "libpng could not start (out of memory)");
-  }
-  png_destroy_write_struct(&png, &info);  // either may be null
-
-  // fclose writes what stdio still buffers: its failure is a write failure.
-  struct stat st {};
-  const bool regular = fstat(fileno(ctx.file), &st) == 0 && S_ISREG(st.st_mode);
-  if (std::fclose(ctx.file) != 0 && ok) {
-    ok = false;
-    ctx.write_errno = errno != 0 ? errno : EIO;
-  }
-  if (ok) return true;
-  // A half-written PNG must not pass for a snapshot; never unlink a device.
-  if (regular) ::unlink(path.c_str());
-  if (ctx.write_errno != 0) return fail(error, "cannot write " + path + ": " + std::strerror(ctx.write_errno));
-  return fail(error, "cannot write " + path + ": libpng: " + ctx.message);
+  const Picture picture{left, right, width, height, stride, guide_every_px};
+  return write_rgb_png(path, 2 * width, height, fill_row, &picture, error);
 }
 
 }  // namespace rtfuse::apps

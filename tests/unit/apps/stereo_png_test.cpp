@@ -3,7 +3,6 @@
 #include "apps/stereo_png.hpp"
 
 #include <gtest/gtest.h>
-#include <png.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,39 +12,15 @@
 #include <string>
 #include <vector>
 
+#include "unit/apps/png_readback.hpp"
+
 namespace rtfuse::apps {
 namespace {
 
-struct Rgb {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> px;
-  const std::uint8_t* at(int x, int y) const { return &px[(static_cast<std::size_t>(y) * width + x) * 3]; }
-};
+using test_png::read_rgb_png;
+using test_png::RgbImage;
 
-// The file as libpng reads it; fails the test unless it is 8-bit RGB.
-Rgb read_png(const std::string& path) {
-  Rgb out;
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&image, path.c_str())) {
-    ADD_FAILURE() << path << ": " << image.message;
-    return out;
-  }
-  EXPECT_EQ(image.format, static_cast<png_uint_32>(PNG_FORMAT_RGB)) << "8-bit RGB, no alpha";
-  image.format = PNG_FORMAT_RGB;
-  out.width = static_cast<int>(image.width);
-  out.height = static_cast<int>(image.height);
-  out.px.resize(PNG_IMAGE_SIZE(image));
-  if (!png_image_finish_read(&image, nullptr, out.px.data(), 0, nullptr)) {
-    ADD_FAILURE() << path << ": " << image.message;
-    out = Rgb{};
-  }
-  return out;
-}
-
-std::string temp_path(const char* name) {
-  return ::testing::TempDir() + "rtfuse_stereo_png_" + std::to_string(::getpid()) + "_" + name;
-}
+std::string temp_path(const char* name) { return test_png::temp_png("rtfuse_stereo_png_", name); }
 
 struct Pair {
   static constexpr int kW = 64, kH = 40, kStride = 80;
@@ -68,7 +43,7 @@ TEST(StereoPng, EyesSideBySideWithGuideLines) {
   ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
                                &error))
       << error;
-  const Rgb img = read_png(path);
+  const RgbImage img = read_rgb_png(path);
   ASSERT_EQ(img.width, 2 * Pair::kW);
   ASSERT_EQ(img.height, Pair::kH);
 
@@ -105,7 +80,7 @@ TEST(StereoPng, NoGuideLinesWhenTheSpacingIsZero) {
   ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 0,
                                &error))
       << error;
-  const Rgb img = read_png(path);
+  const RgbImage img = read_rgb_png(path);
   ASSERT_EQ(img.height, Pair::kH);
   EXPECT_EQ(img.at(5, 20)[0], 5 + 40);
   EXPECT_EQ(img.at(5, 20)[1], 5 + 40);
