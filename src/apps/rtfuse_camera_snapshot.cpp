@@ -9,6 +9,7 @@
 // Exit: 0 written, 1 camera or file failure (the message says which), 2 usage/config.
 #include <cstdio>
 #include <cstring>
+#include <ctime>
 #include <memory>
 #include <string>
 
@@ -34,8 +35,32 @@ class NullSink final : public rtfuse::MessageSink {
   bool publish(const char*, const std::uint8_t*, int, rtfuse::TimeNs) override { return true; }
 };
 
+// What the PNG's header says of the pair: where it comes from, and the
+// stamp that is t = 0 with what starts there (null: the wall-clock time).
+struct PairOrigin {
+  std::string source;
+  rtfuse::TimeNs t0 = 0;
+  const char* t0_name = nullptr;
+};
+
+std::string pair_when(const rtfuse::FramePool::Frame& f, const PairOrigin& origin) {
+  char buf[128];
+  if (origin.t0_name != nullptr) {
+    std::snprintf(buf, sizeof buf, "frame counter %u, t = %.3f s into %s", f.sequence,
+                  static_cast<double>(f.stamp - origin.t0) * 1e-9, origin.t0_name);
+  } else {
+    const std::time_t now = std::time(nullptr);
+    char stamp[32] = "?";
+    std::tm local{};
+    if (localtime_r(&now, &local) != nullptr) std::strftime(stamp, sizeof stamp, "%Y-%m-%d %H:%M:%S", &local);
+    std::snprintf(buf, sizeof buf, "frame counter %u, taken %s", f.sequence, stamp);
+  }
+  return buf;
+}
+
 int write_pair(rtfuse::FramePool& pool, const rtfuse::drivers::StereoRectification& r,
-               const rtfuse::drivers::StereoCameraStats& st, const std::string& out_path, int guide_px) {
+               const rtfuse::drivers::StereoCameraStats& st, const std::string& out_path, int guide_px,
+               const PairOrigin& origin) {
   rtfuse::FramePool::Handle h = pool.take_latest();
   if (!h.valid()) {
     std::fprintf(stderr, "rtfuse-camera-snapshot: no frame from the camera (%lld dequeued, %lld timeouts, %lld rejected): %s\n",
@@ -45,15 +70,18 @@ int write_pair(rtfuse::FramePool& pool, const rtfuse::drivers::StereoRectificati
   }
   const rtfuse::FramePool::Frame f = pool.frame(h);
   std::string error;
-  const bool ok = rtfuse::apps::write_stereo_png(out_path, f.left, f.right, f.width, f.height, f.stride, guide_px, &error);
+  const rtfuse::apps::StereoPngHeader header{origin.source, pair_when(f, origin), r.fx, r.cx, r.cy, r.baseline_m};
+  const bool ok =
+      rtfuse::apps::write_stereo_png(out_path, f.left, f.right, f.width, f.height, f.stride, guide_px, &header, &error);
   pool.release(h);
   if (!ok) {
     std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
     return 1;
   }
   std::printf("{\"out\": \"%s\", \"width\": %d, \"height\": %d, \"sequence\": %u, \"fx\": %.3f, \"cx\": %.3f, "
-              "\"cy\": %.3f, \"baseline_m\": %.5f}\n",
-              out_path.c_str(), f.width, f.height, f.sequence, r.fx, r.cx, r.cy, r.baseline_m);
+              "\"cy\": %.3f, \"baseline_m\": %.5f, \"header_rows\": %d}\n",
+              out_path.c_str(), f.width, f.height, f.sequence, r.fx, r.cx, r.cy, r.baseline_m,
+              rtfuse::apps::stereo_png_header_rows(f.width));
   return 0;
 }
 
@@ -116,7 +144,8 @@ int from_recording(const std::string& log_path, const std::string& out_path, int
       if (h.valid()) pool.release(h);
     }
   }
-  return write_pair(pool, driver->rectified(), driver->stats(), out_path, guide_px);
+  return write_pair(pool, driver->rectified(), driver->stats(), out_path, guide_px,
+                    PairOrigin{"recording " + log_path, rec.info.start_ns, "the recording"});
 }
 
 }  // namespace
@@ -195,5 +224,8 @@ int main(int argc, char** argv) {
   const std::int64_t want = (skip < 0 ? 0 : skip) + 1;
   // Ten seconds of steps at most: a camera that gives nothing is reported.
   for (int k = 0; k < 200 && camera.samples() < want; ++k) camera.step(rtfuse::kDeviceStepTimeoutNs);
-  return write_pair(camera.pool(), camera.rectified(), camera.stats(), out_path, guide_px);
+  const std::string device(cfg.hardware.camera.device.view());
+  const PairOrigin origin = sim_clock ? PairOrigin{"simulated camera of " + config_path, t0, "the simulated drive"}
+                                      : PairOrigin{"camera " + device + " of " + config_path, 0, nullptr};
+  return write_pair(camera.pool(), camera.rectified(), camera.stats(), out_path, guide_px, origin);
 }

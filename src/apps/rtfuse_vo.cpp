@@ -14,6 +14,7 @@
 #include <chrono>
 #include <cinttypes>
 #include <cstdio>
+#include <filesystem>
 #include <string>
 #include <vector>
 
@@ -35,6 +36,14 @@ double percentile(std::vector<double> v, double p) {
   return v[i];
 }
 
+// The folder's own name ("kitti06_0000_0050" of ".../kitti06_0000_0050/"):
+// the plot's title.
+std::string sequence_name(const std::string& dir) {
+  const std::filesystem::path p(dir);
+  const std::string name = p.filename().string();
+  return name.empty() ? p.parent_path().filename().string() : name;
+}
+
 void print_errors(const rtfuse::apps::TrajectoryErrors& e) {
   std::printf(", \"path_length_m\": %.3f, \"final_error_m\": %.4f, \"final_error_pct\": %.3f, \"ate_rmse_m\": %.4f, "
               "\"final_rotation_error_deg\": %.4f, \"rpe_translation_m\": %.4f, \"rpe_rotation_deg\": %.4f",
@@ -52,7 +61,8 @@ int main(int argc, char** argv) {
   app.add_option("--kitti", dir, "sequence folder: image_l/ image_r/ (or image_0/ image_1/), calib.txt, [poses.txt]")
       ->required();
   app.add_option("-o,--out", out_path, "poses to write, KITTI format");
-  app.add_option("--plot", plot_path, "PNG: top view of the trajectory (and the ground truth)");
+  app.add_option("--plot", plot_path,
+                 "PNG: top view against the ground truth in metres, legend, key figures, the error over frames");
   app.add_option("-n,--frames", max_frames, "at most this many frames (0: all)");
   app.add_option("--eval-from", eval_from,
                  "also judge the frames from this one on against the ground truth, both re-anchored there "
@@ -149,7 +159,26 @@ int main(int argc, char** argv) {
       return 1;
     }
   }
-  if (!plot_path.empty() && !rtfuse::apps::write_trajectory_plot(plot_path, poses, seq.ground_truth, &error)) {
+  // The figures the JSON line and the plot both show, computed once.
+  rtfuse::apps::TrajectoryPlotFigures figures;
+  figures.title = sequence_name(dir);
+  figures.frames = static_cast<int>(frames);
+  figures.solved = solved;
+  figures.failed = failed;
+  figures.unreadable = unreadable;
+  figures.ms_per_frame_median = percentile(ms, 0.5);
+  figures.ms_per_frame_p99 = percentile(ms, 0.99);
+  if (!seq.ground_truth.empty()) {
+    figures.errors = rtfuse::apps::compare_trajectories(poses, seq.ground_truth);
+    if (eval_from > 0) {
+      const auto first = static_cast<std::size_t>(eval_from);
+      figures.eval_from = eval_from;
+      figures.stretch_errors = rtfuse::apps::compare_trajectories(rtfuse::apps::reanchored(poses, first),
+                                                                  rtfuse::apps::reanchored(seq.ground_truth, first));
+    }
+  }
+  if (!plot_path.empty() &&
+      !rtfuse::apps::write_trajectory_plot(plot_path, poses, seq.ground_truth, figures, &error)) {
     std::fprintf(stderr, "rtfuse-vo: %s\n", error.c_str());
     return 1;
   }
@@ -159,15 +188,12 @@ int main(int argc, char** argv) {
               frames, solved, failed, unreadable, processed > 0 ? static_cast<double>(features) / processed : 0.0,
               processed > 0 ? static_cast<double>(matches) / processed : 0.0,
               solved > 0 ? static_cast<double>(inliers) / solved : 0.0,
-              percentile(ms, 0.5), percentile(ms, 0.99));
-  if (!seq.ground_truth.empty()) {
-    const rtfuse::apps::TrajectoryErrors e = rtfuse::apps::compare_trajectories(poses, seq.ground_truth);
-    print_errors(e);
-    if (eval_from > 0) {
-      const auto first = static_cast<std::size_t>(eval_from);
+              figures.ms_per_frame_median, figures.ms_per_frame_p99);
+  if (figures.errors) {
+    print_errors(*figures.errors);
+    if (figures.stretch_errors) {
       std::printf(", \"from_frame\": {\"first\": %d", eval_from);
-      print_errors(rtfuse::apps::compare_trajectories(rtfuse::apps::reanchored(poses, first),
-                                                      rtfuse::apps::reanchored(seq.ground_truth, first)));
+      print_errors(*figures.stretch_errors);
       std::printf("}");
     }
   }

@@ -1,64 +1,85 @@
 #include "apps/stereo_png.hpp"
 
 #include <png.h>
-#include <sys/stat.h>
-#include <unistd.h>
 
-#include <cerrno>
-#include <csetjmp>
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
 #include <vector>
 
+#include "apps/bitmap_font.hpp"
+#include "apps/canvas.hpp"
+#include "apps/legend.hpp"
+#include "apps/rgb_png.hpp"
+
 namespace rtfuse::apps {
 namespace {
 
-// What the libpng callbacks report back: they cannot throw or return an
-// error, only longjmp out of libpng.
-struct PngContext {
-  std::FILE* file = nullptr;
-  int write_errno = 0;    // errno of a failed write (ENOSPC, EIO, ...)
-  char message[256] = {};  // libpng's own error text
-};
+constexpr int kHeaderLines = 5;
+constexpr int kHeaderPad = 8;
+constexpr Rgb kHeaderPaper{245, 245, 245};
+constexpr Rgb kHeaderInk{0, 0, 0};
+constexpr Rgb kHeaderRule{90, 90, 90};
 
-void on_error(png_structp png, png_const_charp message) {
-  auto* ctx = static_cast<PngContext*>(png_get_error_ptr(png));
-  std::snprintf(ctx->message, sizeof ctx->message, "%s", message != nullptr ? message : "unknown error");
-  png_longjmp(png, 1);
+// Text twice the font's size on a pair wide enough to hold a line of it
+// (VGA and up), else the font's own size: the header reads at either.
+int header_scale(int width) { return 2 * width >= 900 ? 2 : 1; }
+
+std::string format(const char* fmt, double a, double b, double c, double d) {
+  char buf[160];
+  std::snprintf(buf, sizeof buf, fmt, a, b, c, d);
+  return buf;
 }
 
-// Warnings (e.g. an unusual but valid setting) do not fail the write.
-void on_warning(png_structp, png_const_charp) {}
-
-// Our own I/O callbacks rather than png_init_io: libpng's say "Write Error"
-// and drop errno, and the caller must be told "No space left on device".
-void on_write(png_structp png, png_bytep data, std::size_t size) {
-  auto* ctx = static_cast<PngContext*>(png_get_io_ptr(png));
-  errno = 0;
-  if (std::fwrite(data, 1, size, ctx->file) != size) {
-    ctx->write_errno = errno != 0 ? errno : EIO;
-    png_error(png, "write failed");
+// The band: what, when, the rectified camera, the guide lines' legend, and
+// which half is which eye; a rule under it to set it off from the pair.
+Canvas draw_header(const StereoPngHeader& h, int width, int height, int guide_every_px) {
+  const int s = header_scale(width);
+  Canvas band(2 * width, stereo_png_header_rows(width), kHeaderPaper);
+  const int line = kLineSpacing * s;
+  int y = kHeaderPad;
+  band.text(kHeaderPad, y, "rectified stereo pair: " + h.source, kHeaderInk, s, true);
+  y += line;
+  const std::string size = std::to_string(width) + " x " + std::to_string(height) + " px per eye";
+  band.text(kHeaderPad, y, h.when.empty() ? size : size + ", " + h.when, kHeaderInk, s);
+  y += line;
+  band.text(kHeaderPad, y,
+            format("rectified fx %.2f px, cx %.2f px, cy %.2f px, baseline %.4f m", h.fx, h.cx, h.cy, h.baseline_m),
+            kHeaderInk, s);
+  y += line;
+  const Rgb green{kGuideRgb[0], kGuideRgb[1], kGuideRgb[2]};
+  const std::string guides = guide_every_px > 0
+                                 ? "guide every " + std::to_string(guide_every_px) +
+                                       " rows: a feature sits on the same line in both eyes"
+                                 : "no guide lines (--guide 0)";
+  draw_legend_row(band, kHeaderPad, y, {LegendEntry{guides, green, false, Marker::kDisc, 3, false}}, s);
+  y += line;
+  for (int eye = 0; eye < 2; ++eye) {
+    const char* name = eye == 0 ? "left eye" : "right eye";
+    band.text(eye * width + (width - text_width(name, s)) / 2, y, name, kHeaderInk, s, true);
   }
+  band.fill_rect(Rect{0, band.height() - 2, band.width(), 2}, kHeaderRule);
+  return band;
 }
 
-void on_flush(png_structp png) {
-  auto* ctx = static_cast<PngContext*>(png_get_io_ptr(png));
-  if (std::fflush(ctx->file) != 0) {
-    ctx->write_errno = errno != 0 ? errno : EIO;
-    png_error(png, "flush failed");
-  }
-}
-
-struct Pair {
+struct Picture {
   const std::uint8_t* left;
   const std::uint8_t* right;
   int width, height, stride, guide_every_px;
+  const Canvas* header;  // null: no band
+  int header_rows;
 };
 
-// One RGB row of the picture: the two eyes as grey, or a guide line.
-void fill_row(const Pair& p, int y, std::uint8_t* row) noexcept {
+// One RGB row of the picture: the header band, the two eyes as grey, or a
+// guide line.
+void fill_row(const void* context, int y, std::uint8_t* row) noexcept {
+  const Picture& p = *static_cast<const Picture*>(context);
   const int n = 2 * p.width;
+  if (y < p.header_rows) {
+    std::memcpy(row, p.header->row(y), static_cast<std::size_t>(n) * 3u);
+    return;
+  }
+  y -= p.header_rows;
   if (p.guide_every_px > 0 && y > 0 && y % p.guide_every_px == 0) {
     for (int x = 0; x < n; ++x) std::memcpy(row + 3 * x, kGuideRgb, 3);
     return;
@@ -71,22 +92,6 @@ void fill_row(const Pair& p, int y, std::uint8_t* row) noexcept {
   }
 }
 
-// png_error longjmps back to the setjmp here, skipping every frame in
-// between: this function and libpng's frames hold nothing with a destructor
-// (the row buffer belongs to the caller), so nothing is leaked or skipped.
-bool write_rows(png_structp png, png_infop info, const Pair& p, std::uint8_t* row) {
-  if (setjmp(png_jmpbuf(png))) return false;
-  png_set_IHDR(png, info, static_cast<png_uint_32>(2 * p.width), static_cast<png_uint_32>(p.height), 8,
-               PNG_COLOR_TYPE_RGB, PNG_INTERLACE_NONE, PNG_COMPRESSION_TYPE_DEFAULT, PNG_FILTER_TYPE_DEFAULT);
-  png_write_info(png, info);
-  for (int y = 0; y < p.height; ++y) {
-    fill_row(p, y, row);
-    png_write_row(png, row);
-  }
-  png_write_end(png, nullptr);
-  return true;
-}
-
 bool fail(std::string* error, const std::string& message) {
   if (error != nullptr) *error = message;
   return false;
@@ -94,8 +99,19 @@ bool fail(std::string* error, const std::string& message) {
 
 }  // namespace
 
+int stereo_png_header_rows(int width) {
+  const int s = header_scale(width);
+  return 2 * kHeaderPad + (kHeaderLines - 1) * kLineSpacing * s + text_height(s) + 2;  // + the rule
+}
+
 bool write_stereo_png(const std::string& path, const std::uint8_t* left, const std::uint8_t* right, int width,
                       int height, int stride, int guide_every_px, std::string* error) {
+  return write_stereo_png(path, left, right, width, height, stride, guide_every_px, nullptr, error);
+}
+
+bool write_stereo_png(const std::string& path, const std::uint8_t* left, const std::uint8_t* right, int width,
+                      int height, int stride, int guide_every_px, const StereoPngHeader* header,
+                      std::string* error) {
   const std::string what = "stereo PNG " + path + ": ";
   // Checked before opening, so bad arguments never truncate an existing file.
   if (left == nullptr || right == nullptr) return fail(error, what + "no image (null pixels)");
@@ -103,39 +119,15 @@ bool write_stereo_png(const std::string& path, const std::uint8_t* left, const s
     return fail(error, what + "size " + std::to_string(width) + "x" + std::to_string(height) + " must be positive");
   if (stride < width)
     return fail(error, what + "stride " + std::to_string(stride) + " is less than the width " + std::to_string(width));
-  if (width > PNG_USER_WIDTH_MAX / 2 || height > PNG_USER_HEIGHT_MAX)
+  const int header_rows = header != nullptr ? stereo_png_header_rows(width) : 0;
+  if (width > PNG_USER_WIDTH_MAX / 2 || height > PNG_USER_HEIGHT_MAX - header_rows)
     return fail(error, what + "pair " + std::to_string(width) + "x" + std::to_string(height) +
                            " exceeds libpng's limits (" + std::to_string(PNG_USER_WIDTH_MAX) + " px per side)");
 
-  PngContext ctx;
-  ctx.file = std::fopen(path.c_str(), "wb");
-  if (ctx.file == nullptr) return fail(error, "cannot open " + path + ": " + std::strerror(errno));
-
-  std::vector<std::uint8_t> row(static_cast<std::size_t>(width) * 6u);
-  png_structp png = png_create_write_struct(PNG_LIBPNG_VER_STRING, &ctx, on_error, on_warning);
-  png_infop info = png != nullptr ? png_create_info_struct(png) : nullptr;
-  bool ok = false;
-  if (png != nullptr && info != nullptr) {
-    png_set_write_fn(png, &ctx, on_write, on_flush);
-    const Pair pair{left, right, width, height, stride, guide_every_px};
-    ok = write_rows(png, info, pair, row.data());
-  } else {
-    std::snprintf(ctx.message, sizeof ctx.message, "libpng could not start (out of memory)");
-  }
-  png_destroy_write_struct(&png, &info);  // either may be null
-
-  // fclose writes what stdio still buffers: its failure is a write failure.
-  struct stat st {};
-  const bool regular = fstat(fileno(ctx.file), &st) == 0 && S_ISREG(st.st_mode);
-  if (std::fclose(ctx.file) != 0 && ok) {
-    ok = false;
-    ctx.write_errno = errno != 0 ? errno : EIO;
-  }
-  if (ok) return true;
-  // A half-written PNG must not pass for a snapshot; never unlink a device.
-  if (regular) ::unlink(path.c_str());
-  if (ctx.write_errno != 0) return fail(error, "cannot write " + path + ": " + std::strerror(ctx.write_errno));
-  return fail(error, "cannot write " + path + ": libpng: " + ctx.message);
+  Canvas band(1, 1, kHeaderPaper);
+  if (header != nullptr) band = draw_header(*header, width, height, guide_every_px);
+  const Picture picture{left, right, width, height, stride, guide_every_px, &band, header_rows};
+  return write_rgb_png(path, 2 * width, header_rows + height, fill_row, &picture, error);
 }
 
 }  // namespace rtfuse::apps

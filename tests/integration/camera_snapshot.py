@@ -1,7 +1,8 @@
 #!/usr/bin/python3
 """rtfuse-camera-snapshot on the simulated robot's camera: a rectified pair as
-a PNG with guide lines, the same from an rtfused --record log, and the
-refusals (no [camera], a missing calibration, a recording without frames)."""
+a PNG with guide lines under a header band, the same from an rtfused --record
+log, and the refusals (no [camera], a missing calibration, a recording without frames)."""
+import json
 import os
 import shlex
 import subprocess
@@ -31,10 +32,17 @@ def sim_config(calibration):
     return text.replace('calibration = "calibration/SN10000001.conf"', 'calibration = "%s"' % calibration)
 
 
-def check_png(out):
-    img = matplotlib.image.imread(out)
-    if img.shape != (376, 1344, 3):
-        fail("PNG is %s, expected 376 x 1344 RGB (two VGA eyes)" % (img.shape,))
+def check_png(out, summary_line):
+    """The pair below its header band (the JSON's header_rows), as before."""
+    top = json.loads(summary_line)["header_rows"]
+    full = matplotlib.image.imread(out)
+    if full.shape != (top + 376, 1344, 3):
+        fail("PNG is %s, expected %d header rows + 376 x 1344 RGB (two VGA eyes)" % (full.shape, top))
+    # The header band: dark text on light paper, not the camera's pixels.
+    band = full[:top]
+    if not (band > 0.9).mean() > 0.5 or not (band < 0.1).any():
+        fail("the header band (rows 0..%d) holds no text on paper" % (top - 1))
+    img = full[top:]
     # Guide lines are green across both eyes; other rows are grey.
     if not (img[24, :, 1] > 0.99).all() or not (img[24, :, 0] < 0.01).all():
         fail("row 24 is not a green guide line")
@@ -83,7 +91,7 @@ def main():
         p, out = run(sim_config(cal), tmp, "-g", "24", "-t", "10")
         if p.returncode != 0:
             fail("exit %d: %s" % (p.returncode, p.stderr))
-        check_png(out)
+        check_png(out, p.stdout.strip().splitlines()[-1])
         print("snapshot:", p.stdout.strip())
 
         # From a recording: its frames, configuration and calibration.
@@ -93,7 +101,7 @@ def main():
                            timeout=240)
         if p.returncode != 0:
             fail("--recording: exit %d: %s" % (p.returncode, p.stderr))
-        check_png(out)
+        check_png(out, p.stdout.strip().splitlines()[-1])
         print("from a recording:", p.stdout.strip())
 
         p, _ = run(sim_config(None), tmp)

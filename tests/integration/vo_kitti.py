@@ -94,8 +94,8 @@ def check_kitti(tmp):
     lines = open(poses).read().splitlines()
     if len(lines) != 51 or [float(x) for x in lines[0].split()] != [1, 0, 0, 0, 0, 1, 0, 0, 0, 0, 1, 0]:
         fail(f"{len(lines)} pose lines, the first {lines[0] if lines else None}")
-    if matplotlib.image.imread(plot).shape[:2] != (800, 800):
-        fail("the plot is not an 800 x 800 image")
+    if matplotlib.image.imread(plot).shape[:2] != (1100, 1280):
+        fail("the plot is not a 1280 x 1100 image")
 
 
 def check_bad(tmp):

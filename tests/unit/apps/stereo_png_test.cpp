@@ -1,9 +1,9 @@
 // write_stereo_png, read back with libpng: size, format, each eye's pixels,
-// the guide lines, and errors that name the path and the errno text.
+// the guide lines, the header band above them, and errors that name the path
+// and the errno text.
 #include "apps/stereo_png.hpp"
 
 #include <gtest/gtest.h>
-#include <png.h>
 #include <sys/stat.h>
 #include <unistd.h>
 
@@ -13,39 +13,15 @@
 #include <string>
 #include <vector>
 
+#include "unit/apps/png_readback.hpp"
+
 namespace rtfuse::apps {
 namespace {
 
-struct Rgb {
-  int width = 0, height = 0;
-  std::vector<std::uint8_t> px;
-  const std::uint8_t* at(int x, int y) const { return &px[(static_cast<std::size_t>(y) * width + x) * 3]; }
-};
+using test_png::read_rgb_png;
+using test_png::RgbImage;
 
-// The file as libpng reads it; fails the test unless it is 8-bit RGB.
-Rgb read_png(const std::string& path) {
-  Rgb out;
-  png_image image{};
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_file(&image, path.c_str())) {
-    ADD_FAILURE() << path << ": " << image.message;
-    return out;
-  }
-  EXPECT_EQ(image.format, static_cast<png_uint_32>(PNG_FORMAT_RGB)) << "8-bit RGB, no alpha";
-  image.format = PNG_FORMAT_RGB;
-  out.width = static_cast<int>(image.width);
-  out.height = static_cast<int>(image.height);
-  out.px.resize(PNG_IMAGE_SIZE(image));
-  if (!png_image_finish_read(&image, nullptr, out.px.data(), 0, nullptr)) {
-    ADD_FAILURE() << path << ": " << image.message;
-    out = Rgb{};
-  }
-  return out;
-}
-
-std::string temp_path(const char* name) {
-  return ::testing::TempDir() + "rtfuse_stereo_png_" + std::to_string(::getpid()) + "_" + name;
-}
+std::string temp_path(const char* name) { return test_png::temp_png("rtfuse_stereo_png_", name); }
 
 struct Pair {
   static constexpr int kW = 64, kH = 40, kStride = 80;
@@ -68,7 +44,7 @@ TEST(StereoPng, EyesSideBySideWithGuideLines) {
   ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
                                &error))
       << error;
-  const Rgb img = read_png(path);
+  const RgbImage img = read_rgb_png(path);
   ASSERT_EQ(img.width, 2 * Pair::kW);
   ASSERT_EQ(img.height, Pair::kH);
 
@@ -105,7 +81,7 @@ TEST(StereoPng, NoGuideLinesWhenTheSpacingIsZero) {
   ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 0,
                                &error))
       << error;
-  const Rgb img = read_png(path);
+  const RgbImage img = read_rgb_png(path);
   ASSERT_EQ(img.height, Pair::kH);
   EXPECT_EQ(img.at(5, 20)[0], 5 + 40);
   EXPECT_EQ(img.at(5, 20)[1], 5 + 40);
@@ -149,6 +125,68 @@ TEST(StereoPng, BadArgumentsLeaveAnExistingFileAlone) {
   std::getline(std::ifstream(path), content);
   EXPECT_EQ(content, "previous snapshot");
   ::unlink(path.c_str());
+}
+
+// With a header the pair keeps every pixel and guide line, moved down by
+// exactly the rows stereo_png_header_rows says; above it the band carries
+// dark text and the green guide swatch on light paper.
+TEST(StereoPng, HeaderBandAboveTheUnchangedPair) {
+  const Pair pair;
+  const std::string plain_path = temp_path("no_header.png"), path = temp_path("header.png");
+  std::string error;
+  ASSERT_TRUE(write_stereo_png(plain_path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
+                               &error))
+      << error;
+  const StereoPngHeader header{"camera /dev/video7 of robot.toml", "frame counter 12, t = 1.500 s into the test",
+                               350.5, 320.25, 180.75, 0.12};
+  ASSERT_TRUE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
+                               &header, &error))
+      << error;
+  const RgbImage plain = read_rgb_png(plain_path), img = read_rgb_png(path);
+  const int top = stereo_png_header_rows(Pair::kW);
+  ASSERT_GT(top, 0);
+  ASSERT_EQ(img.width, 2 * Pair::kW);
+  ASSERT_EQ(img.height, top + Pair::kH);
+  ASSERT_EQ(plain.height, Pair::kH);
+  int moved = 0;
+  for (int y = 0; y < Pair::kH; ++y)
+    for (int x = 0; x < img.width; ++x)
+      for (int c = 0; c < 3; ++c) moved += plain.at(x, y)[c] != img.at(x, top + y)[c] ? 1 : 0;
+  EXPECT_EQ(moved, 0) << "the pair below the band is the picture without a header";
+  EXPECT_TRUE(is_guide(img.at(3, top + 10)));
+  EXPECT_FALSE(is_guide(img.at(3, 10)));
+
+  int ink = 0, paper = 0;
+  for (int y = 0; y < top; ++y)
+    for (int x = 0; x < img.width; ++x) {
+      const std::uint8_t* p = img.at(x, y);
+      ink += p[0] < 64 && p[1] < 64 && p[2] < 64 ? 1 : 0;
+      paper += p[0] > 200 && p[1] > 200 && p[2] > 200 ? 1 : 0;
+    }
+  EXPECT_GT(ink, 100) << "text in the band";
+  EXPECT_GT(paper, img.width * top / 2) << "light paper under it";
+  EXPECT_GT(img.count(kGuideRgb[0], kGuideRgb[1], kGuideRgb[2], 0, 0, img.width, top), 0)
+      << "the guide lines' legend swatch";
+  ::unlink(plain_path.c_str());
+  ::unlink(path.c_str());
+}
+
+// A pair as wide as a VGA camera's gets the header in twice the font's size:
+// the band is taller than on a small pair, and its text fits the width.
+TEST(StereoPng, HeaderRowsGrowWithTheTextScale) {
+  EXPECT_GT(stereo_png_header_rows(672), stereo_png_header_rows(64));
+  EXPECT_EQ(stereo_png_header_rows(672), stereo_png_header_rows(1920));
+}
+
+TEST(StereoPng, HeaderedWriteErrorNamesThePathAndErrno) {
+  const Pair pair;
+  const StereoPngHeader header{"here", "now", 1.0, 2.0, 3.0, 0.1};
+  const std::string path = temp_path("no_such_dir") + "/pair.png";
+  std::string error;
+  EXPECT_FALSE(write_stereo_png(path, pair.left.data(), pair.right.data(), Pair::kW, Pair::kH, Pair::kStride, 10,
+                                &header, &error));
+  EXPECT_NE(error.find(path), std::string::npos) << error;
+  EXPECT_NE(error.find("No such file or directory"), std::string::npos) << error;
 }
 
 }  // namespace
