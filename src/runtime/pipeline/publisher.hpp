@@ -14,15 +14,11 @@
 #include "core/time.hpp"
 #include "runtime/config/config.hpp"
 #include "runtime/fusion/snapshot.hpp"
+#include "transport/message_sink.hpp"
 
 namespace rtfuse {
 
-class MessageSink {
- public:
-  virtual ~MessageSink() = default;
-  // The bytes are valid only during the call. False: the message was lost.
-  virtual bool publish(const char* channel, const std::uint8_t* data, int size, TimeNs now) = 0;
-};
+using MessageSink = transport::MessageSink;
 
 class Publisher {
  public:
