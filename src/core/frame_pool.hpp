@@ -194,6 +194,15 @@ class FramePool {
     return f;
   }
 
+  // A second reference to a frame the caller holds (a consumer keeping a
+  // pair it was lent for the length of a call). Never fails: the slot's
+  // count is at least the caller's 1, so it cannot be free.
+  Handle retain(const Handle& h) noexcept {
+    if (!h.valid()) return Handle{};
+    refs_[h.slot].fetch_add(1, std::memory_order_relaxed);
+    return h;
+  }
+
   // Gives a frame back; the handle becomes invalid.
   void release(Handle& h) noexcept {
     if (h.valid()) unref(h.slot);
