@@ -218,12 +218,12 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
     return 1;
   }
-  rtfuse::CameraDevice& camera = *pipeline->hardware()->camera();
+  rtfuse::CameraDevice& camera = *pipeline->hardware()->find<rtfuse::CameraDevice>("camera");
   // The simulated drive's pose at --time: the camera's frames follow it.
   if (sim_clock) sim_clock->set(t0 + rtfuse::sec_to_ns(at_s));
   const std::int64_t want = (skip < 0 ? 0 : skip) + 1;
   // Ten seconds of steps at most: a camera that gives nothing is reported.
-  for (int k = 0; k < 200 && camera.samples() < want; ++k) camera.step(rtfuse::kDeviceStepTimeoutNs);
+  for (int k = 0; k < 200 && camera.frames() < want; ++k) camera.step(rtfuse::kDeviceStepTimeoutNs);
   const std::string device(cfg.hardware.camera.device.view());
   const PairOrigin origin = sim_clock ? PairOrigin{"simulated camera of " + config_path, t0, "the simulated drive"}
                                       : PairOrigin{"camera " + device + " of " + config_path, 0, nullptr};

@@ -77,4 +77,13 @@ void SimCamera::stall_until(TimeNs until) noexcept {
   if (until > next_) next_ += (until - next_ + period_ - 1) / period_ * period_;
 }
 
+void SimCamera::provide(DeviceBuses& out, hal::Clock& clock) noexcept {
+  out.video = stream_.get();
+  out.clock = &clock;
+}
+
+std::unique_ptr<SimDevice> make_sim_camera(const SimDeviceContext& ctx, std::string* error) {
+  return SimCamera::create(ctx.cfg, ctx.truth, ctx.clock, ctx.t0, ctx.scenario.seed, error);
+}
+
 }  // namespace rtfuse::sim

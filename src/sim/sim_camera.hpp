@@ -15,12 +15,17 @@
 #include "hal/mock/mock_video_stream.hpp"
 #include "runtime/config/config.hpp"
 #include "sim/camera_world.hpp"
+#include "sim/sim_device.hpp"
 #include "sim/stereo_renderer.hpp"
 #include "sim/truth_trajectory.hpp"
 
 namespace rtfuse::sim {
 
-class SimCamera final : public hal::mock::FrameSource {
+// The camera's counterpart (sim_device.hpp): the calibration file's camera,
+// rendering the scenario's world from the robot's pose through its mount.
+std::unique_ptr<SimDevice> make_sim_camera(const SimDeviceContext& ctx, std::string* error);
+
+class SimCamera final : public hal::mock::FrameSource, public SimDevice {
  public:
   // The camera section's calibration file and mode, the mount from the
   // config's static transforms. Null with *error when they do not fit.
@@ -36,6 +41,10 @@ class SimCamera final : public hal::mock::FrameSource {
   void stall_until(TimeNs until) noexcept;
   // Capture time of the next frame: what the lockstep drive steps the camera thread up to.
   TimeNs next_frame_time() noexcept override { return next_; }
+
+  // SimDevice: its video stream and the robot's clock.
+  void provide(DeviceBuses& out, hal::Clock& clock) noexcept override;
+  TimeNs next_event_time() noexcept override { return next_; }
   std::uint32_t fill(TimeNs stamp, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override;
 
  private:

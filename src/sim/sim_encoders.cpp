@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
 
 namespace rtfuse::sim {
 
@@ -130,6 +131,49 @@ hal::HalStatus SimEncoders::send(const hal::CanFrame& frame) noexcept {
 int SimEncoders::receive(hal::CanFrame* out, int max, TimeNs timeout_ns, hal::HalStatus* status) noexcept {
   update(clock_.now());
   return bus_.receive(out, max, timeout_ns, status);
+}
+
+void SimEncoders::provide(DeviceBuses& out, hal::Clock&) noexcept { out.can = this; }
+
+TimeNs SimEncoders::next_event_time() noexcept { return std::numeric_limits<TimeNs>::max(); }
+
+std::unique_ptr<SimDevice> make_sim_encoders(const SimDeviceContext& ctx, std::string* error) {
+  const RobotBody& body = ctx.scenario.robot;
+  const CanSection& can = ctx.cfg.hardware.can;
+  const std::string& path = ctx.scenario_path;
+  // The config must address the simulated encoders, or the driver would talk
+  // to nobody and the run would say nothing useful.
+  for (int i = 0; i < can.num_nodes; ++i) {
+    const CanNodeSection& n = can.nodes[static_cast<std::size_t>(i)];
+    const std::string node = ctx.cfg.source + ": can.node[" + std::to_string(i) + "]";
+    bool found = false;
+    for (int w = 0; w < body.wheel_count; ++w) {
+      const SimWheel& wheel = body.wheels[static_cast<std::size_t>(w)];
+      if (wheel.node_id != n.node_id) continue;
+      found = true;
+      // A counter of another width or signedness unwraps at the wrong
+      // place: jumps and wrong counts, with no error to say why.
+      if (n.position_bits != body.encoder_bits || n.position_signed != body.encoder_signed) {
+        *error = node + " reads a " + std::to_string(n.position_bits) + "-bit " +
+                 (n.position_signed ? "signed" : "unsigned") + " position but the simulated encoder in " + path +
+                 " counts " + std::to_string(body.encoder_bits) + "-bit " +
+                 (body.encoder_signed ? "signed" : "unsigned");
+        return nullptr;
+      }
+      const bool inverted = wheel.left ? body.invert_left : body.invert_right;
+      if ((n.sign < 0) != inverted) {
+        *error = node + ".sign = " + std::to_string(n.sign) + " but the simulated encoder in " + path +
+                 (inverted ? " counts down" : " counts up") + " driving forward";
+        return nullptr;
+      }
+    }
+    if (!found) {
+      *error = node + ".node_id = " + std::to_string(n.node_id) + " is not an encoder of the simulated robot in " +
+               path;
+      return nullptr;
+    }
+  }
+  return std::make_unique<SimEncoders>(ctx.scenario, ctx.truth, ctx.clock, ctx.t0);
 }
 
 }  // namespace rtfuse::sim

@@ -21,8 +21,13 @@
 #include "hal/mock/mock_can_bus.hpp"
 #include "sim/drive_scenario.hpp"
 #include "sim/truth_trajectory.hpp"
+#include "sim/sim_device.hpp"
 
 namespace rtfuse::sim {
+
+// The wheel encoders' counterpart (sim_device.hpp): the configuration's
+// [[can.node]]s must be the scenario's encoders, counting the same way.
+std::unique_ptr<SimDevice> make_sim_encoders(const SimDeviceContext& ctx, std::string* error);
 
 // The encoder count of `wheel` in `truth`, unwrapped: floor(angle * cpr *
 // gear / 2 pi), with angle = rolled distance / true radius, negated for an
@@ -32,7 +37,7 @@ std::int64_t wheel_counts(const RobotBody& robot, const TruthState& truth, int w
 // [0, 2^bits), or [-2^(bits-1), 2^(bits-1)) when signed.
 std::int64_t wrap_position(std::int64_t counts, int bits, bool is_signed) noexcept;
 
-class SimEncoders final : public hal::CanBus {
+class SimEncoders final : public hal::CanBus, public SimDevice {
  public:
   // `truth` and `clock` must outlive this.
   SimEncoders(const DriveScenario& scenario, const TruthTrajectory& truth, const hal::Clock& clock, TimeNs t0);
@@ -44,6 +49,10 @@ class SimEncoders final : public hal::CanBus {
   // windows that began or ended since the last call. send() and receive()
   // call it with the clock's now; call it yourself only to inspect.
   void update(TimeNs now) noexcept;
+
+  // SimDevice: the loop polls the encoders; nothing to wait for.
+  void provide(DeviceBuses& out, hal::Clock& clock) noexcept override;
+  TimeNs next_event_time() noexcept override;
 
   int wheel_count() const noexcept { return wheel_count_; }
   const sim::CanopenEncoderNode& node(int wheel) const noexcept { return *nodes_[wheel]; }

@@ -148,4 +148,22 @@ hal::HalStatus SimGnss::write(const std::uint8_t* data, int size) noexcept {
   return st;
 }
 
+void SimGnss::provide(DeviceBuses& out, hal::Clock& clock) noexcept {
+  out.serial = this;
+  out.clock = &clock;
+}
+
+std::unique_ptr<SimDevice> make_sim_gnss(const SimDeviceContext& ctx, std::string* error) {
+  if (!ctx.scenario.gnss.enabled) {
+    *error = ctx.cfg.source + ": [gnss] is configured but the scenario " + ctx.scenario_path +
+             " has no [gnss] receiver on the simulated robot";
+    return nullptr;
+  }
+  if (ctx.cfg.hardware.gnss.protocol != GnssProtocolConfig::kUbx) {
+    *error = ctx.cfg.source + ": gnss.protocol: the simulated receiver speaks ubx (u-blox NAV-PVT)";
+    return nullptr;
+  }
+  return std::make_unique<SimGnss>(ctx.scenario, ctx.truth, ctx.clock, ctx.t0);
+}
+
 }  // namespace rtfuse::sim

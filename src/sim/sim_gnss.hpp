@@ -21,9 +21,14 @@
 #include "hal/clock.hpp"
 #include "hal/mock/mock_serial_port.hpp"
 #include "sim/drive_scenario.hpp"
+#include "sim/sim_device.hpp"
 #include "sim/truth_trajectory.hpp"
 
 namespace rtfuse::sim {
+
+// The GNSS receiver's counterpart (sim_device.hpp): the scenario must
+// carry a receiver, and it speaks UBX.
+std::unique_ptr<SimDevice> make_sim_gnss(const SimDeviceContext& ctx, std::string* error);
 
 // The error of epoch k, in ENU metres, and whether the receiver has a fix.
 struct SimGnssEpoch {
@@ -35,12 +40,16 @@ struct SimGnssEpoch {
   double error_enu[3] = {};
 };
 
-class SimGnss final : public hal::SerialPort {
+class SimGnss final : public hal::SerialPort, public SimDevice {
  public:
   SimGnss(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0);
 
   // When the next epoch's bytes start to arrive.
   TimeNs next_arrival() const noexcept;
+
+  // SimDevice: its serial port and the robot's clock.
+  void provide(DeviceBuses& out, hal::Clock& clock) noexcept override;
+  TimeNs next_event_time() noexcept override { return next_arrival(); }
   // What epoch k is (errors included), for k at or after the last epoch
   // asked for or sent (the receiver's error has state: it advances to k).
   const SimGnssEpoch& epoch(std::int64_t k) noexcept;

@@ -161,4 +161,20 @@ const char* SimImu::config_mismatch() const noexcept {
   return nullptr;
 }
 
+void SimImu::provide(DeviceBuses& out, hal::Clock& clock) noexcept {
+  out.i2c = this;
+  out.edge = this;
+  out.clock = &clock;
+}
+
+std::unique_ptr<SimDevice> make_sim_imu(const SimDeviceContext& ctx, std::string* error) {
+  const MpuSection& m = ctx.cfg.hardware.mpu;
+  if (m.address != ctx.scenario.imu.address) {
+    *error = ctx.cfg.source + ": mpu.address = " + std::to_string(m.address) + " but the simulated IMU in " +
+             ctx.scenario_path + " answers at " + std::to_string(ctx.scenario.imu.address);
+    return nullptr;
+  }
+  return std::make_unique<SimImu>(ctx.scenario, ctx.truth, ctx.clock, ctx.t0);
+}
+
 }  // namespace rtfuse::sim

@@ -28,8 +28,13 @@
 #include "sim/devices/mpu_register_file.hpp"
 #include "sim/drive_scenario.hpp"
 #include "sim/truth_trajectory.hpp"
+#include "sim/sim_device.hpp"
 
 namespace rtfuse::sim {
+
+// The IMU's counterpart (sim_device.hpp): mpu.address must be the
+// scenario's chip's.
+std::unique_ptr<SimDevice> make_sim_imu(const SimDeviceContext& ctx, std::string* error);
 
 // One sample before quantisation, in the IMU frame.
 struct ImuSample {
@@ -38,7 +43,7 @@ struct ImuSample {
   double temperature_c = 0.0;
 };
 
-class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource {
+class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimDevice {
  public:
   // `truth` and `clock` must outlive this.
   SimImu(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0);
@@ -48,6 +53,10 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource {
 
   // When the next sample is taken (an edge if the chip has data-ready on).
   TimeNs next_edge_time() const noexcept { return sample_time(next_); }
+
+  // SimDevice: its I2C bus, its data-ready line, the robot's clock.
+  void provide(DeviceBuses& out, hal::Clock& clock) noexcept override;
+  TimeNs next_event_time() noexcept override { return next_edge_time(); }
   TimeNs sample_time(std::int64_t k) const noexcept;
   // Sample k as the chip's sensors see it, noise and bias included.
   ImuSample sample(std::int64_t k) const noexcept;

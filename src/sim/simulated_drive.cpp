@@ -134,16 +134,17 @@ DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& op
     // them before the loop woke. Bounded: a driver that is down (re-init
     // backing off) does not wait, and the event time would not move.
     for (int d = 0; d < pipeline->thread_device_count(); ++d) {
-      ThreadDevice& device = pipeline->thread_device(d);
+      Device& device = pipeline->thread_device(d);
+      const char* name = pipeline->thread_device_name(d);
       for (int k = 0; k < 64; ++k) {
-        const TimeNs due = robot->next_event_time(device.name());
+        const TimeNs due = robot->next_event_time(name);
         if (due > t) break;
         device.step(kDeviceStepTimeoutNs);
         clock.set(t);
         // No progress (the device is down, its driver backing off between
         // reopens): once per tick, as its thread would wake about once per
         // tick; more would run the backoff on a clock that cannot advance.
-        if (robot->next_event_time(device.name()) == due) break;
+        if (robot->next_event_time(name) == due) break;
       }
       clock.set(t);
     }

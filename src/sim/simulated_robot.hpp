@@ -1,8 +1,9 @@
 #pragma once
-// The bus-level simulated robot as one HalBuses: its encoder nodes on a CAN
-// bus (for the loop thread), its MPU with a data-ready line (for the IMU
-// thread), on a clock that is real (rtfused live) or simulated (rtfuse-sim,
-// tests). Ground truth is a pure function of time, so both sides, and the
+// The bus-level simulated robot as one HalBuses: the simulated counterpart
+// of each device the configuration drives (encoder nodes on a CAN bus, an
+// MPU with a data-ready line, a rendering stereo camera, a u-blox receiver;
+// sim_device.hpp), on a clock that is real (rtfused live) or simulated
+// (rtfuse-sim, tests). Ground truth is a pure function of time, so both sides, and the
 // truth output, agree without sharing state between threads.
 #include <memory>
 #include <string>
@@ -14,10 +15,7 @@
 #include "runtime/config/config.hpp"
 #include "runtime/devices/hal_buses.hpp"
 #include "sim/drive_scenario.hpp"
-#include "sim/sim_camera.hpp"
-#include "sim/sim_encoders.hpp"
-#include "sim/sim_gnss.hpp"
-#include "sim/sim_imu.hpp"
+#include "sim/sim_device.hpp"
 #include "sim/truth_trajectory.hpp"
 
 namespace rtfuse::sim {
@@ -25,8 +23,9 @@ namespace rtfuse::sim {
 class SimulatedRobot {
  public:
   // Loads the scenario named by cfg.hardware.scenario (or `scenario_path`
-  // when given) and checks that the robot configuration can talk to it: the
-  // encoder node ids and the IMU address must be the simulated ones.
+  // when given) and makes the simulated counterpart of every device the
+  // configuration drives (sim_device_registry.cpp), each checking that the
+  // robot configuration can talk to it (node ids, addresses, protocols).
   // scenario_text, when not null, is the scenario itself (a built-in one)
   // and scenario_path only names it in messages.
   static std::unique_ptr<SimulatedRobot> create(const RuntimeConfig& cfg, const std::string& scenario_path,
@@ -36,29 +35,30 @@ class SimulatedRobot {
   HalBuses buses();
   const DriveScenario& scenario() const { return scenario_; }
   const TruthTrajectory& truth() const { return *truth_; }
-  SimImu& imu() { return *imu_; }
-  SimEncoders& encoders() { return *encoders_; }
-  SimCamera* camera() { return camera_.get(); }  // null without [camera]
-  SimGnss* gnss() { return gnss_.get(); }        // null without [gnss]
+  // The counterpart of the registered device `name` as its type (SimImu for
+  // "imu", SimEncoders, SimCamera, SimGnss); null when the configuration
+  // has no such device. For fault injection and inspection.
+  template <class T>
+  T* device(std::string_view name) noexcept {
+    const int i = find_device_type(name);
+    return i < 0 ? nullptr : dynamic_cast<T*>(devices_[i].get());
+  }
   TimeNs start_time() const { return t0_; }
   // The drive's length (scenario duration, or the path's).
   double duration_s() const;
   TruthState truth_at(TimeNs t) const noexcept;
-  // When the simulated device behind the thread device `name` ("imu",
-  // "camera") next has something for its driver (a data-ready edge, a
-  // frame's end of exposure); far in the future for
-  // a device this robot does not simulate. The lockstep drive steps each
-  // thread device up to the tick with it.
-  TimeNs next_event_time(std::string_view name) const noexcept;
+  // When the counterpart of the thread device `name` ("imu", "camera")
+  // next has something for its driver; far in the future for a device this
+  // robot does not simulate. The lockstep drive steps each thread device up
+  // to the tick with it.
+  TimeNs next_event_time(std::string_view name) noexcept;
 
  private:
   SimulatedRobot() = default;
+  std::string scenario_path_;
   DriveScenario scenario_;
   std::unique_ptr<TruthTrajectory> truth_;
-  std::unique_ptr<SimEncoders> encoders_;
-  std::unique_ptr<SimImu> imu_;
-  std::unique_ptr<SimCamera> camera_;
-  std::unique_ptr<SimGnss> gnss_;
+  std::unique_ptr<SimDevice> devices_[kMaxDeviceTypes];  // at their registry index
   hal::Clock* clock_ = nullptr;
   TimeNs t0_ = 0;
 };

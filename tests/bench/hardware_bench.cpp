@@ -34,11 +34,13 @@
 #include "hal/mock/sim_clock.hpp"
 #include "live_camera_rig.hpp"
 #include "support/sim_toml.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/hal_replay.hpp"
-#include "runtime/hardware.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/replay/hal_replay.hpp"
+#include "runtime/devices/hardware.hpp"
+#include "runtime/devices/imu/imu_device.hpp"
 #include "sim/simulated_drive.hpp"
+#include "sim/sim_imu.hpp"
 #include "sim/simulated_robot.hpp"
 #include "support/alloc_counter.hpp"
 #include "transport/event_log.hpp"
@@ -119,7 +121,9 @@ void BM_HardwareTick(benchmark::State& state) {
     state.SkipWithError(("Hardware::start: " + error).c_str());
     return;
   }
-  if (hw->imu() == nullptr) {
+  rtfuse::ImuDevice* imu_device = hw->find<rtfuse::ImuDevice>("imu");
+  rtfuse::sim::SimImu* sim_imu = robot->device<rtfuse::sim::SimImu>("imu");
+  if (imu_device == nullptr || sim_imu == nullptr) {
     state.SkipWithError("config/sim.toml runs no IMU driver: the benchmark would measure the encoders only");
     return;
   }
@@ -134,7 +138,7 @@ void BM_HardwareTick(benchmark::State& state) {
   auto one_period = [&]() {
     t += kPeriodNs;
     clock.set(t);
-    for (int k = 0; k < 64 && robot->imu().next_edge_time() <= t; ++k) hw->imu()->step_imu(rtfuse::kDeviceStepTimeoutNs);
+    for (int k = 0; k < 64 && sim_imu->next_edge_time() <= t; ++k) imu_device->step_imu(rtfuse::kDeviceStepTimeoutNs);
     clock.set(t);
     ++loop.ticks;
     core->tick(t, loop);
@@ -163,7 +167,7 @@ void BM_HardwareTick(benchmark::State& state) {
     });
   }
   const rtfuse::Snapshot s0 = core->last_snapshot();
-  const std::int64_t imu0 = hw->imu()->samples();
+  const std::int64_t imu0 = imu_device->samples();
   // Per-iteration durations, sized before the timed loop.
   std::vector<std::int64_t> durations(static_cast<std::size_t>(state.max_iterations), 0);
   std::size_t n = 0;
@@ -205,7 +209,7 @@ void BM_HardwareTick(benchmark::State& state) {
   const double iters = static_cast<double>(state.iterations());
   state.counters["wheel_per_iter"] = static_cast<double>(wheels) / iters;
   state.counters["imu_per_iter"] = static_cast<double>(imu) / iters;
-  const std::int64_t imu_read = hw->imu()->samples() - imu0;
+  const std::int64_t imu_read = imu_device->samples() - imu0;
   if (!s1.initialized) {
     state.SkipWithError("the filter never initialised");
   } else if (wheels < state.iterations() * 9 / 10 || imu < state.iterations() / 5 * 9 / 10 ||

@@ -25,8 +25,10 @@
 #include <sstream>
 #include <string>
 
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 #include "sim/sim_camera.hpp"
+#include "sim/sim_encoders.hpp"
+#include "sim/sim_imu.hpp"
 #include "sim/simulated_drive.hpp"
 #include "sim/simulated_robot.hpp"
 
@@ -239,8 +241,8 @@ TEST(FaultMatrix, SilentCanNode) {
   Row r{"silent CAN node", "right encoder node off the bus 10-14 s (no heartbeat, no TPDO)", kFrom, kFrom + 4,
         "wheel right node 2", nullptr, false, {}};
   r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
-    if (t >= kFrom && t < kFrom + 4) robot.encoders().set_silent(1, true, now);
-    if (t >= kFrom + 4) robot.encoders().set_silent(1, false, now);
+    if (t >= kFrom && t < kFrom + 4) robot.device<sim::SimEncoders>("wheel_encoders")->set_silent(1, true, now);
+    if (t >= kFrom + 4) robot.device<sim::SimEncoders>("wheel_encoders")->set_silent(1, false, now);
   };
   expect_handled(measure(r), 0.6, 0.5, 1.0, 0.3);
 }
@@ -249,7 +251,7 @@ TEST(FaultMatrix, StuckCounter) {
   Row r{"stuck counter", "right encoder's count frozen 10-14 s while driving", kFrom, kFrom + 4, "wheel right node 2",
         nullptr, false, {}};
   r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
-    robot.encoders().set_stuck(1, t >= kFrom && t < kFrom + 4, now);
+    robot.device<sim::SimEncoders>("wheel_encoders")->set_stuck(1, t >= kFrom && t < kFrom + 4, now);
   };
   expect_handled(measure(r), 1.5, 0.5, 2.5, 1.5);
 }
@@ -259,7 +261,7 @@ TEST(FaultMatrix, CounterJump) {
         "wheel right node 2", "jump_events", false, {}};
   r.inject = [done = false](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) mutable {
     if (!done && t >= kFrom) {
-      robot.encoders().jump(1, 5000);
+      robot.device<sim::SimEncoders>("wheel_encoders")->jump(1, 5000);
       done = true;
     }
   };
@@ -270,7 +272,7 @@ TEST(FaultMatrix, CounterJump) {
 TEST(FaultMatrix, BusOff) {
   Row r{"bus-off", "CAN controller bus-off 10-12 s, then error-active", kFrom, kFrom + 2, "can bus", nullptr, false, {}};
   r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
-    robot.encoders().bus().set_state(t >= kFrom && t < kFrom + 2 ? hal::CanBusState::kBusOff
+    robot.device<sim::SimEncoders>("wheel_encoders")->bus().set_state(t >= kFrom && t < kFrom + 2 ? hal::CanBusState::kBusOff
                                                                  : hal::CanBusState::kErrorActive);
   };
   expect_handled(measure(r), 0.1, 0.5, 1.0, 0.3);
@@ -284,7 +286,7 @@ TEST(FaultMatrix, UnknownFramesFlood) {
     hal::CanFrame f;
     f.id = 0x555;
     f.dlc = 8;
-    for (int i = 0; i < 40; ++i) robot.encoders().bus().inject(f);
+    for (int i = 0; i < 40; ++i) robot.device<sim::SimEncoders>("wheel_encoders")->bus().inject(f);
   };
   const Measured m = measure(r);
   expect_handled(m, 0.1, 0.1, 0.5, 0.1);
@@ -295,14 +297,14 @@ TEST(FaultMatrix, UnknownFramesFlood) {
 TEST(FaultMatrix, ImuNacks) {
   Row r{"IMU NACKs", "every I2C transfer to the MPU NACKed 10-12 s", kFrom, kFrom + 2, "imu", nullptr, false, {}};
   r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
-    robot.imu().chip().nack_next(t >= kFrom && t < kFrom + 2 ? 1'000'000 : 0);
+    robot.device<sim::SimImu>("imu")->chip().nack_next(t >= kFrom && t < kFrom + 2 ? 1'000'000 : 0);
   };
   expect_handled(measure(r), 0.2, 1.5, 1.0, 1.0);
 }
 
 TEST(FaultMatrix, FrozenImu) {
   Row r{"frozen IMU", "the MPU's data registers stop updating 10-14 s", kFrom, kFrom + 4, "imu", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) { robot.imu().chip().set_frozen(t >= kFrom && t < kFrom + 4); };
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) { robot.device<sim::SimImu>("imu")->chip().set_frozen(t >= kFrom && t < kFrom + 4); };
   expect_handled(measure(r), 0.2, 1.5, 1.0, 1.0);
 }
 
@@ -313,7 +315,7 @@ TEST(FaultMatrix, Saturation) {
     const bool on = t >= kFrom && t < kFrom + 0.2;
     const double a[3] = {on ? 50.0 : 0.0, 0, 0};
     const double g[3] = {0, 0, on ? 10.0 : 0.0};
-    robot.imu().set_disturbance(a, g);
+    robot.device<sim::SimImu>("imu")->set_disturbance(a, g);
   };
   expect_handled(measure(r), 0.1, 0.1, 1.0, 0.2);
 }
@@ -321,7 +323,7 @@ TEST(FaultMatrix, Saturation) {
 TEST(FaultMatrix, MissingDataReadyEdges) {
   Row r{"missing data-ready edges", "the MPU's data-ready edges lost 10-14 s (samples still latched)", kFrom, kFrom + 4,
         "imu", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) { robot.imu().set_edges_lost(t >= kFrom && t < kFrom + 4); };
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) { robot.device<sim::SimImu>("imu")->set_edges_lost(t >= kFrom && t < kFrom + 4); };
   expect_handled(measure(r), 0.5, 1.0, 1.0, 1.0);
 }
 
@@ -332,8 +334,8 @@ TEST(FaultMatrix, CameraStall) {
   Row r{"camera stall", "no frames 6-9 s (the sensor stops; frames due meanwhile never exposed)", kCamFrom,
         kCamFrom + 3, "camera", nullptr, true, {}};
   r.inject = [done = false](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) mutable {
-    if (!done && t >= kCamFrom && robot.camera() != nullptr) {
-      robot.camera()->stall_until(robot.start_time() + sec_to_ns(kCamFrom + 3));
+    if (!done && t >= kCamFrom && robot.device<sim::SimCamera>("camera") != nullptr) {
+      robot.device<sim::SimCamera>("camera")->stall_until(robot.start_time() + sec_to_ns(kCamFrom + 3));
       done = true;
     }
   };
@@ -344,14 +346,14 @@ TEST(FaultMatrix, CameraUnplugged) {
   Row r{"camera unplugged", "the stream goes away at 6 s and every reopen fails until 9 s", kCamFrom, kCamFrom + 3,
         "camera", nullptr, true, {}};
   r.inject = [state = 0](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) mutable {
-    if (robot.camera() == nullptr) return;
+    if (robot.device<sim::SimCamera>("camera") == nullptr) return;
     if (state == 0 && t >= kCamFrom) {
-      robot.camera()->mock_stream().unplug();
-      robot.camera()->mock_stream().refuse_reopens(1'000'000);
+      robot.device<sim::SimCamera>("camera")->mock_stream().unplug();
+      robot.device<sim::SimCamera>("camera")->mock_stream().refuse_reopens(1'000'000);
       state = 1;
     }
     if (state == 1 && t >= kCamFrom + 3) {
-      robot.camera()->mock_stream().refuse_reopens(0);
+      robot.device<sim::SimCamera>("camera")->mock_stream().refuse_reopens(0);
       state = 2;
     }
   };

@@ -10,6 +10,7 @@
 #include "estimation/filter_params.hpp"
 #include "geometry/rigid_transform.hpp"
 #include "runtime/config/hardware_config.hpp"
+#include "runtime/config/name.hpp"
 
 namespace rtfuse {
 
@@ -21,16 +22,17 @@ constexpr int kMaxStaticTransforms = 24;
 // one in odom, a global one in map) and one more, e.g. to compare tunings.
 constexpr int kMaxInstances = 3;
 
-using Name = FixedString<63>;
 
-// Where a sensor's samples come from: decoded LCM messages, or one of the
-// drivers this process runs.
-enum class SensorSource : std::uint8_t { kLcm, kWheelOdometry, kMpu, kStereoVo, kGnss };
+// Where a sensor's samples come from: decoded LCM messages, or a source of
+// one of the devices this process drives (an index into the registry's
+// sources, devices/device_registry.hpp).
+using SensorSource = std::int8_t;
+constexpr SensorSource kLcmSource = -1;
 
 struct SensorConfig {
   Name name;        // "odom0", "imu0", ... (robot_localization's sensor names)
   Name channel;     // LCM channel (the ROS topic, unchanged); empty for drivers
-  SensorSource source = SensorSource::kLcm;
+  SensorSource source = kLcmSource;
   est::SensorParams params;
   // LCM sensors: messages beyond this rate (a burst of one ring, 2 x
   // queue_size, allowed) are dropped before decoding and counted. The loader

@@ -15,7 +15,8 @@
 #include <vector>
 
 #include "geometry/rotation.hpp"
-#include "runtime/config/hardware_config_loader.hpp"
+#include "runtime/devices/device_config.hpp"
+#include "runtime/devices/device_registry.hpp"
 #include "runtime/config/toml_reader.hpp"
 
 namespace rtfuse {
@@ -341,18 +342,14 @@ SensorEntry read_sensor(const Section& s) {
   e.has_name = s.read_name("name", e.cfg.name);
   std::string source = "lcm";
   if (s.read("source", source)) {
+    // lcm, or a source of a registered device (devices/device_registry).
+    const int id = find_device_source(source);
     if (source == "lcm") {
-      e.cfg.source = SensorSource::kLcm;
-    } else if (source == "wheel_odometry") {
-      e.cfg.source = SensorSource::kWheelOdometry;
-    } else if (source == "mpu") {
-      e.cfg.source = SensorSource::kMpu;
-    } else if (source == "stereo_vo") {
-      e.cfg.source = SensorSource::kStereoVo;
-    } else if (source == "gnss") {
-      e.cfg.source = SensorSource::kGnss;
+      e.cfg.source = kLcmSource;
+    } else if (id >= 0) {
+      e.cfg.source = static_cast<SensorSource>(id);
     } else {
-      s.value_error("source", "must be one of lcm, wheel_odometry, mpu, stereo_vo, gnss, got " + in_quotes(source));
+      s.value_error("source", "must be one of " + device_source_names() + ", got " + in_quotes(source));
     }
   }
   // A driver-fed sensor has no channel; an LCM one needs it.
@@ -466,7 +463,7 @@ void read_sensors(const Section& parent, RuntimeConfig& cfg, const std::vector<C
     }
     // A driver's samples: shared with an earlier instance's sensor on it
     // (two of one instance are read_hardware's error).
-    for (int j = 0; j < first && e.cfg.source != SensorSource::kLcm; ++j) {
+    for (int j = 0; j < first && e.cfg.source != kLcmSource; ++j) {
       const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];
       if (o.source != e.cfg.source || sensor_input(cfg, j) != j) continue;
       if (o.params.kind != e.cfg.params.kind) {
@@ -669,8 +666,11 @@ void read_sim(const Section& s, LcmSimConfig& sim) {
 }
 
 void read_root(const Section& root, RuntimeConfig& cfg) {
-  root.reject_unknown({"filter", "realtime", "lcm", "publish", "sensor", "instance", "static_transform", "sim",
-                       "hardware", "can", "wheel_odometry", "mpu", "camera", "vo", "gnss"});
+  // The devices' sections are theirs to name (devices/device_registry.cpp).
+  std::vector<std::string_view> sections{"filter",   "realtime",         "lcm", "publish", "sensor",
+                                         "instance", "static_transform", "sim"};
+  for (std::string_view d : config::device_sections()) sections.push_back(d);
+  root.reject_unknown(sections);
   Diagnostics& d = root.diag();
   read_filter(Section(section_table(root, "filter"), "filter", d), cfg);
   read_realtime(Section(section_table(root, "realtime"), "realtime", d), cfg.realtime);
@@ -686,7 +686,7 @@ void read_root(const Section& root, RuntimeConfig& cfg) {
     if (sc.max_rate_hz == 0.0) sc.max_rate_hz = 2.0 * sc.params.queue_size * cfg.rate_hz;
   }
   read_static_transforms(root, cfg);
-  config::read_hardware(root, cfg, sites);
+  config::read_devices(root, cfg, sites);
   read_sim(Section(section_table(root, "sim"), "sim", d), cfg.sim);
 }
 

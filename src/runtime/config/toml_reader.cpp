@@ -162,7 +162,9 @@ void Section::table_error(std::string key, std::string msg) const {
   diag_.add(table_ ? table_->source() : toml::source_region{}, std::move(key), std::move(msg));
 }
 
-void Section::reject_unknown(Keys allowed) const {
+void Section::reject_unknown(Keys allowed) const { reject_unknown(std::vector<std::string_view>(allowed)); }
+
+void Section::reject_unknown(const std::vector<std::string_view>& allowed) const {
   if (!table_) return;
   for (auto&& [k, v] : *table_) {
     (void)v;

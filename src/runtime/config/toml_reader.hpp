@@ -72,6 +72,7 @@ class Section {
   void table_error(std::string key, std::string msg) const;
 
   void reject_unknown(Keys allowed) const;
+  void reject_unknown(const std::vector<std::string_view>& allowed) const;
   void require(Keys keys) const;
   bool type_error(std::string_view k, const toml::node& n, std::string_view expected) const;
 

@@ -1,45 +1,30 @@
 #pragma once
 // The bus primitives the drivers of one configuration run on, whatever
-// provides them: the kernel (runtime/linux_hal), the simulated robot
-// (sim/), or a recording (replay). One named slot per device thread, each
-// with the clock that thread waits on; null where the configuration has no
-// such device. Not owned.
-#include "hal/can_bus.hpp"
-#include "hal/clock.hpp"
-#include "hal/gpio.hpp"
-#include "hal/i2c_bus.hpp"
-#include "hal/serial_port.hpp"
-#include "hal/video_stream.hpp"
+// provides them: the kernel (linux_hal), the simulated robot (src/sim), or a
+// recording (replay/). One DeviceBuses per registered device, at its index in
+// the registry; empty where the configuration has no such device. Not owned.
+#include <cassert>
+#include <string_view>
+
+#include "runtime/devices/device_buses.hpp"
+#include "runtime/devices/device_registry.hpp"
 
 namespace rtfuse {
 
-// The IMU thread's: the chip's bus, its data-ready line (null: poll at
-// mpu.poll_rate) and the clock for polling and reset delays.
-struct ImuBuses {
-  hal::I2cBus* i2c = nullptr;
-  hal::GpioEdgeSource* data_ready = nullptr;
-  hal::Clock* clock = nullptr;
-};
-
-// The camera thread's: the stereo camera's stream, and the clock it backs
-// off on while the camera is unplugged.
-struct CameraBuses {
-  hal::VideoStream* video = nullptr;
-  hal::Clock* clock = nullptr;
-};
-
-// The GNSS thread's: the receiver's serial port, and the clock it measures
-// silence and reopen backoffs on.
-struct GnssBuses {
-  hal::SerialPort* serial = nullptr;
-  hal::Clock* clock = nullptr;
-};
-
 struct HalBuses {
-  hal::CanBus* can = nullptr;  // the wheel encoders' bus, polled by the loop thread
-  ImuBuses imu;
-  CameraBuses camera;
-  GnssBuses gnss;
+  DeviceBuses device[kMaxDeviceTypes];
+
+  // The device of that registered name (tests and tools set buses by hand;
+  // an unknown name is a programming error).
+  DeviceBuses& of(std::string_view name) noexcept { return device[index(name)]; }
+  const DeviceBuses& of(std::string_view name) const noexcept { return device[index(name)]; }
+
+ private:
+  static int index(std::string_view name) noexcept {
+    const int i = find_device_type(name);
+    assert(i >= 0 && "no registered device of that name");
+    return i < 0 ? 0 : i;
+  }
 };
 
 }  // namespace rtfuse

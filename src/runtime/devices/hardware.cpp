@@ -1,59 +1,91 @@
 #include "runtime/devices/hardware.hpp"
 
-namespace rtfuse {
+#include "runtime/devices/frame_consumer.hpp"
+#include "runtime/devices/device_layout.hpp"
 
-Hardware::Hardware(const RuntimeConfig& cfg) : slots_(device_slots(cfg)) {
-  describe_devices(cfg, layout_, kMaxDevices);
+namespace rtfuse {
+namespace {
+
+std::string missing_buses(std::uint32_t missing) {
+  std::string out;
+  for (int k = 0; k < kBusKinds; ++k) {
+    if ((missing & (1u << k)) == 0) continue;
+    if (!out.empty()) out += ", ";
+    out += to_string(static_cast<BusKind>(k));
+  }
+  return out;
 }
+
+}  // namespace
 
 std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& core, std::string* error) {
   const RuntimeConfig& cfg = core.config();
-  std::unique_ptr<Hardware> h(new Hardware(cfg));
-  const HardwareConfig& hw = cfg.hardware;
-  if (hw.can.enabled) {
-    if (buses.can == nullptr) {
-      *error = "[can] is configured but the HAL has no CAN bus";
+  std::unique_ptr<Hardware> h(new Hardware());
+  const DeviceLayout layout = device_layout(cfg);
+  if (layout.device_slots > kMaxDevices) {
+    *error = "the configuration's devices need " + std::to_string(layout.device_slots) +
+             " diagnostics slots, more than the " + std::to_string(kMaxDevices) + " a snapshot holds";
+    return nullptr;
+  }
+  describe_devices(cfg, h->layout_, kMaxDevices);
+  h->slot_count_ = layout.device_slots;
+  for (int i = 0; i < device_type_count(); ++i) {
+    const DeviceDescriptor& d = device_type(i);
+    if (!d.enabled(cfg)) continue;
+    const DeviceBuses& b = buses.device[i];
+    const std::uint32_t missing = d.required_buses(cfg) & ~b.present();
+    if (missing != 0) {
+      *error = "[" + std::string(d.sections().front()) + "] is configured but the HAL has no " +
+               missing_buses(missing);
       return nullptr;
     }
-    h->wheels_ = WheelEncoderDevice::create(*buses.can, core, h->slots_, error);
-    if (!h->wheels_) return nullptr;
-  }
-  if (hw.mpu.enabled) {
-    h->imu_ = ImuDevice::create(buses.imu, core, h->slots_.imu, error);
-    if (!h->imu_) return nullptr;
-    h->threaded_[h->num_threaded_++] = h->imu_.get();
-  }
-  if (hw.camera.enabled) {
-    h->camera_ = CameraDevice::create(buses.camera, core, h->slots_.camera, h->slots_.vo, error);
-    if (!h->camera_) return nullptr;
-    h->threaded_[h->num_threaded_++] = h->camera_.get();
-  }
-  if (hw.gnss.enabled) {
-    h->gnss_ = GnssDevice::create(buses.gnss, core, h->slots_.gnss, error);
-    if (!h->gnss_) return nullptr;
-    h->threaded_[h->num_threaded_++] = h->gnss_.get();
+    DeviceContext ctx{core, layout.first_slot[i], nullptr};
+    if (d.host() != nullptr) {
+      const int host = find_device_type(d.host());
+      ctx.host = host >= 0 ? h->devices_[host].get() : nullptr;
+    }
+    std::unique_ptr<Device> device = d.create(ctx, b, error);
+    if (!device) return nullptr;
+    if (ctx.host != nullptr && ctx.host->frame_source() != nullptr && device->frame_consumer() != nullptr &&
+        !ctx.host->frame_source()->attach(*device->frame_consumer(), error)) {
+      return nullptr;
+    }
+    switch (d.scheduling()) {
+      case DeviceScheduling::kPolled: h->polled_[h->num_polled_++] = i; break;
+      case DeviceScheduling::kThread: h->threaded_[h->num_threaded_++] = i; break;
+      case DeviceScheduling::kHostThread: break;
+    }
+    h->devices_[i] = std::move(device);
   }
   return h;
 }
 
 bool Hardware::start(TimeNs now, std::string* error) {
-  if (wheels_ && !wheels_->start(now, error)) return false;
-  if (imu_ && !imu_->start(error)) return false;
+  for (const std::unique_ptr<Device>& d : devices_) {
+    if (d && !d->start(now, error)) return false;
+  }
   return true;
 }
 
 void Hardware::before_drain(TimeNs now) noexcept {
-  if (wheels_) wheels_->before_drain(now);
+  for (int i = 0; i < num_polled_; ++i) devices_[polled_[i]]->poll(now);
 }
 
 void Hardware::fill_snapshot(Snapshot& s) noexcept {
-  s.num_devices = slots_.count;
-  for (int i = 0; i < slots_.count; ++i) {
+  if (s.num_devices < slot_count_) s.num_devices = slot_count_;
+  for (int i = 0; i < slot_count_; ++i) {
     s.devices[i].name = layout_[i].name;
     s.devices[i].hardware_id = layout_[i].hardware_id;
   }
-  if (wheels_) wheels_->fill_snapshot(s);
-  for (int i = 0; i < num_threaded_; ++i) threaded_[i]->fill_snapshot(s);
+  for (const std::unique_ptr<Device>& d : devices_) {
+    if (d) d->fill_snapshot(s);
+  }
+}
+
+void Hardware::publish_due(TimeNs now, transport::MessageSink& sink) noexcept {
+  for (const std::unique_ptr<Device>& d : devices_) {
+    if (d) d->publish_due(now, sink);
+  }
 }
 
 }  // namespace rtfuse

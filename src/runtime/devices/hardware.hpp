@@ -1,63 +1,67 @@
 #pragma once
 // The devices a configuration drives, on whatever buses it is given (kernel,
-// simulated robot, recording): the ones the loop polls inside its tick (the
-// CANopen wheel encoders) and the ones on threads of their own (the IMU),
-// behind one ThreadDevice interface. Their measurements enter the fusion
-// through the same sensor rings as decoded LCM messages, so fusion semantics
-// do not depend on the source.
+// simulated robot, recording): every enabled registered device, made in
+// registry order from its descriptor, frame consumers attached to their
+// hosts. The loop polls the polled ones inside its tick; the live runtime
+// gives each thread device a thread, and the HAL replay and the simulated
+// drive step them in lockstep. No device is named here.
 //
 // Everything is allocated in create(); before_drain(), fill_snapshot() and
-// the thread devices' steps (outside a re-initialisation) allocate nothing.
+// the devices' steps (outside a re-initialisation) allocate nothing.
 #include <memory>
 #include <string>
+#include <string_view>
 
-#include "runtime/devices/camera/camera_device.hpp"
-#include "runtime/devices/device_layout.hpp"
-#include "runtime/fusion/fusion_core.hpp"
-#include "runtime/devices/gnss/gnss_device.hpp"
+#include "runtime/devices/device.hpp"
+#include "runtime/devices/device_registry.hpp"
 #include "runtime/devices/hal_buses.hpp"
-#include "runtime/devices/imu/imu_device.hpp"
-#include "runtime/devices/thread_device.hpp"
-#include "runtime/devices/wheel_encoders/wheel_encoder_device.hpp"
+#include "runtime/fusion/fusion_core.hpp"
 
 namespace rtfuse {
 
-constexpr int kMaxThreadDevices = 4;
-
 class Hardware final : public TickDevices {
  public:
-  // The configuration is the core's.
+  // The configuration is the core's. Null with *error naming the device when
+  // a bus it needs is missing or its driver refuses the configuration.
   static std::unique_ptr<Hardware> create(const HalBuses& buses, FusionCore& core, std::string* error);
 
-  // Before the threads: NMT start to the encoder nodes, IMU identity check
-  // and configuration. False with *error naming the device and the fix.
+  // Before the threads, in registry order: NMT start to the encoder nodes,
+  // the IMU's identity check. False with *error naming the device and the fix.
   bool start(TimeNs now, std::string* error);
 
   // Loop thread (TickDevices).
   void before_drain(TimeNs now) noexcept override;
   void fill_snapshot(Snapshot& s) noexcept override;
+  int slot_count() const noexcept override { return slot_count_; }
 
-  // The devices that want a thread (live) or lockstep steps (replay, simulation).
-  int thread_device_count() const { return num_threaded_; }
-  ThreadDevice& thread_device(int i) { return *threaded_[i]; }
+  // Publisher thread: every device's own outputs (a camera's preview).
+  void publish_due(TimeNs now, transport::MessageSink& sink) noexcept;
 
-  ImuDevice* imu() { return imu_.get(); }
-  CameraDevice* camera() { return camera_.get(); }
-  GnssDevice* gnss() { return gnss_.get(); }
-  const drivers::CanopenEncoders* encoders() const { return wheels_ ? &wheels_->encoders() : nullptr; }
-  const drivers::WheelOdometry* wheel_odometry() const { return wheels_ ? wheels_->wheel_odometry() : nullptr; }
+  // The devices that want a thread (live) or lockstep steps (replay,
+  // simulation), and the name of each: its thread, its recording stream, its
+  // simulated counterpart.
+  int thread_device_count() const noexcept { return num_threaded_; }
+  Device& thread_device(int i) noexcept { return *devices_[threaded_[i]]; }
+  const char* thread_device_name(int i) const noexcept { return device_type(threaded_[i]).name(); }
+
+  // The device of that registered name, as the type its descriptor makes;
+  // null when the configuration has none (tools and tests).
+  template <class T>
+  T* find(std::string_view name) noexcept {
+    const int i = find_device_type(name);
+    return i < 0 ? nullptr : dynamic_cast<T*>(devices_[i].get());
+  }
 
  private:
-  explicit Hardware(const RuntimeConfig& cfg);
+  Hardware() = default;
 
-  DeviceSlots slots_;
-  DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
-  std::unique_ptr<WheelEncoderDevice> wheels_;
-  std::unique_ptr<ImuDevice> imu_;
-  std::unique_ptr<CameraDevice> camera_;
-  std::unique_ptr<GnssDevice> gnss_;
-  ThreadDevice* threaded_[kMaxThreadDevices] = {};
+  std::unique_ptr<Device> devices_[kMaxDeviceTypes];  // at their registry index; null when not enabled
+  int polled_[kMaxDeviceTypes] = {};
+  int num_polled_ = 0;
+  int threaded_[kMaxDeviceTypes] = {};
   int num_threaded_ = 0;
+  DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
+  int slot_count_ = 0;
 };
 
 }  // namespace rtfuse

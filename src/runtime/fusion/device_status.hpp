@@ -1,10 +1,13 @@
 #pragma once
 // Health of the devices the process drives itself (encoder nodes, the CAN
-// bus, the IMU), in the snapshot the loop publishes. Trivially copyable: the
+// bus, the IMU, ...) and of the navsat transforms, in the snapshot the loop
+// publishes. Trivially copyable: the
 // counter names are pointers to string literals, fixed per configuration,
 // and the last error's text is stored inline.
+#include <cstddef>
 #include <cstdint>
 #include <cstring>
+#include <initializer_list>
 
 #include "core/fixed_string.hpp"
 
@@ -52,5 +55,26 @@ struct DeviceStatus {
     }
   }
 };
+
+// A slot's counters are named once, in an array of string literals next to
+// the code that fills them: the layout names the slot with the keys (values
+// 0) and the device sets the values in the same order every tick.
+template <std::size_t N>
+void describe_keys(DeviceStatus& d, const char* const (&keys)[N]) noexcept {
+  static_assert(N <= static_cast<std::size_t>(kMaxDeviceValues), "more counters than a device slot holds");
+  d.num_values = 0;
+  for (const char* k : keys) d.add(k, 0);
+}
+
+template <std::size_t N>
+void set_device_values(DeviceStatus& d, const char* const (&keys)[N],
+                       std::initializer_list<std::int64_t> values) noexcept {
+  d.num_values = 0;
+  std::size_t i = 0;
+  for (std::int64_t v : values) {
+    if (i == N) break;
+    d.add(keys[i++], v);
+  }
+}
 
 }  // namespace rtfuse

@@ -4,6 +4,7 @@
 #include <cstdio>
 
 #include "geometry/rotation.hpp"
+#include "runtime/fusion/navsat_status.hpp"
 
 namespace rtfuse {
 
@@ -97,15 +98,13 @@ bool FusionCore::configure_navsat(std::string* error) {
     if (in.navsat_sensor < 0) in.navsat_sensor = i;
     in.needs_fix = in.in_map;
   }
-  slots_ = device_slots(cfg_);
+  num_navsat_ = navsat_slot_count(cfg_);
   for (int& key : navsat_message_key_) key = -1;
-  if (slots_.num_navsat > 0) {
-    const auto layout = std::make_unique<DeviceStatus[]>(kMaxDevices);
-    describe_devices(cfg_, layout.get(), kMaxDevices);
+  if (num_navsat_ > 0) {
+    describe_navsat(cfg_, navsat_layout_);
     int k = 0;
-    for (int i = 0; i < cfg_.num_sensors && k < slots_.num_navsat; ++i) {
+    for (int i = 0; i < cfg_.num_sensors && k < num_navsat_; ++i) {
       if (cfg_.sensors[i].params.kind != est::SensorKind::kNavSatFix) continue;
-      navsat_layout_[k] = layout[slots_.first_navsat + k];
       navsat_sensor_[k++] = i;
     }
   }
@@ -113,15 +112,17 @@ bool FusionCore::configure_navsat(std::string* error) {
 }
 
 void FusionCore::fill_navsat(Snapshot& s) noexcept {
-  if (slots_.num_navsat == 0) return;
-  if (s.num_devices < slots_.count) s.num_devices = slots_.count;
-  for (int k = 0; k < slots_.num_navsat; ++k) {
-    DeviceStatus& d = s.devices[slots_.first_navsat + k];
+  if (num_navsat_ == 0) return;
+  // After the devices' slots (devices/device_layout.hpp).
+  const int first = devices_ != nullptr ? devices_->slot_count() : 0;
+  if (s.num_devices < first + num_navsat_) s.num_devices = first + num_navsat_;
+  for (int k = 0; k < num_navsat_; ++k) {
+    DeviceStatus& d = s.devices[first + k];
     d.name = navsat_layout_[k].name;
     d.hardware_id = navsat_layout_[k].hardware_id;
     const est::NavsatTransform& n = models_[navsat_sensor_[k]].navsat();
     const est::NavsatStats& st = n.stats();
-    set_device_values(d, kNavsatKeys, kNavsatKeyCount,
+    set_device_values(d, kNavsatKeys,
                       {st.accepted, st.no_fix, st.invalid_position, st.invalid_covariance, st.waiting_for_heading,
                        st.jumps, st.reanchors});
     if (!n.has_transform()) {

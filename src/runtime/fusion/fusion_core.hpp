@@ -9,21 +9,21 @@
 #include "estimation/sensor_model.hpp"
 #include "geometry/frame_tree.hpp"
 #include "runtime/config/config.hpp"
-#include "runtime/devices/device_layout.hpp"
 #include "runtime/fusion/input_router.hpp"
 #include "runtime/fusion/snapshot.hpp"
 
 namespace rtfuse {
 
-// Work the loop does for the devices it drives itself, inside the tick: poll
-// the CAN encoders (their samples go into the sensors' rings before the
-// drain) and report device health and raw wheel odometry into the snapshot. runtime/hardware.cpp.
+// Work the loop does for the devices it drives, inside the tick: poll the
+// polled ones (their samples go into the sensors' rings before the drain)
+// and report device health (and raw wheel odometry) into the snapshot's
+// first slot_count() device slots. devices/hardware.cpp.
 class TickDevices {
  public:
   virtual ~TickDevices() = default;
   virtual void before_drain(TimeNs now) noexcept = 0;
-  // Device statuses and the raw wheel odometry.
   virtual void fill_snapshot(Snapshot& s) noexcept = 0;
+  virtual int slot_count() const noexcept = 0;
 };
 
 class FusionCore {
@@ -92,7 +92,7 @@ class FusionCore {
   TimeNs last_arrival_[kMaxSensors] = {};
   // Per input: the navsat sensors (bit j) whose datum heading it gives.
   std::uint32_t heading_targets_[kMaxSensors] = {};
-  DeviceSlots slots_;
+  int num_navsat_ = 0;
   int navsat_sensor_[kMaxNavsatSensors] = {};
   DeviceStatus navsat_layout_[kMaxNavsatSensors];  // names and ids
   DeviceMessage navsat_message_[kMaxNavsatSensors];

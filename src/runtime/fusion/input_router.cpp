@@ -23,7 +23,7 @@ InputRouter::InputRouter(const RuntimeConfig& cfg, const geometry::FrameTree& fr
 bool InputRouter::on_message(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept {
   const bool oversize = size > cfg_.lcm_max_message_bytes;
   for (int i = 0; i < num_sensors_; ++i) {
-    if (cfg_.sensors[i].source != SensorSource::kLcm) continue;  // a driver feeds it
+    if (cfg_.sensors[i].source != kLcmSource) continue;  // a driver feeds it
     if (std::strcmp(cfg_.sensors[i].channel.c_str(), channel) != 0) continue;
     InputCounters& c = counters_[i];
     c.received.fetch_add(1, std::memory_order_relaxed);

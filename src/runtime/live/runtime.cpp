@@ -36,12 +36,8 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
   if (!rt->pipeline_) return nullptr;
   FusionCore& core = rt->pipeline_->core();
   const RuntimeConfig& c = core.config();
-  if (rt->pipeline_->hardware() != nullptr && rt->pipeline_->hardware()->camera() != nullptr) {
-    rt->camera_outputs_ = CameraOutputs::create(*rt->pipeline_->hardware()->camera(), c.hardware.camera, error);
-    if (!rt->camera_outputs_) return nullptr;
-  }
   for (int i = 0; i < c.num_sensors; ++i) {
-    if (c.sensors[i].source != SensorSource::kLcm) continue;
+    if (c.sensors[i].source != kLcmSource) continue;
     if (!rt->lcm_->subscribe(c.sensors[i].channel.c_str(), &Runtime::on_lcm, &core)) {
       *error = "cannot subscribe to channel '" + std::string(c.sensors[i].channel.view()) + "'";
       return nullptr;
@@ -90,7 +86,7 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   pub_ = std::thread(&Runtime::publisher_thread, this);
   lcmin_ = std::thread(&Runtime::input_thread, this);
   for (int i = 0; i < pipeline_->thread_device_count(); ++i) {
-    devices_[i] = std::thread(&Runtime::device_thread, this, &pipeline_->thread_device(i));
+    devices_[i] = std::thread(&Runtime::device_thread, this, i);
   }
   // Set from here, so a refusal is known before start() returns; a thread
   // runs its first microseconds under SCHED_OTHER, which is still start-up.
@@ -102,7 +98,7 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   };
   io(pub_, "the publisher");
   io(lcmin_, "the LCM input thread");
-  for (int i = 0; i < pipeline_->thread_device_count(); ++i) io(devices_[i], pipeline_->thread_device(i).name());
+  for (int i = 0; i < pipeline_->thread_device_count(); ++i) io(devices_[i], pipeline_->thread_device_name(i));
   if (!io_warnings.empty()) {
     if (rtc.require) {
       stop();
@@ -181,9 +177,10 @@ void Runtime::publisher_thread() {
       publish_jobs_.pop();
     }
     if (!running) break;  // the loop has stopped: everything it queued is out
-    // Not recorded: a preview is for watching, and far larger than a
-    // recorded output may be; the recording has the frames themselves.
-    if (camera_outputs_) camera_outputs_->publish_due(monotonic_now_ns(), *lcm_sink_);
+    // The devices' own outputs (a camera's preview) are not recorded: they
+    // are for watching, and far larger than a recorded output may be; the
+    // recording has the frames themselves.
+    if (Hardware* hw = pipeline_->hardware()) hw->publish_due(monotonic_now_ns(), *lcm_sink_);
     next += period;
     sleep_until(next);
   }
@@ -197,9 +194,10 @@ void Runtime::input_thread() {
   }
 }
 
-void Runtime::device_thread(ThreadDevice* device) {
+void Runtime::device_thread(int index) {
+  Device* device = &pipeline_->thread_device(index);
   char name[16];
-  std::snprintf(name, sizeof name, "rtfuse-%s", device->name());
+  std::snprintf(name, sizeof name, "rtfuse-%s", pipeline_->thread_device_name(index));
   name_this_thread(name);
   // A step that finds nothing (a missing edge, no frame) is the device's to
   // count, not a reason to leave; the timeout bounds how long a stop waits.

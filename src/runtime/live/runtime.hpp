@@ -17,7 +17,6 @@
 
 #include "core/spsc_ring.hpp"
 #include "hal/linux/monotonic_clock.hpp"
-#include "runtime/devices/camera/camera_outputs.hpp"
 #include "runtime/devices/hal_buses.hpp"
 #include "runtime/pipeline/tick_pipeline.hpp"
 #include "transport/lcm_node.hpp"
@@ -79,13 +78,12 @@ class Runtime {
   void loop_thread();
   void publisher_thread();
   void input_thread();
-  void device_thread(ThreadDevice* device);
+  void device_thread(int index);
   static void on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
 
   std::unique_ptr<transport::LcmNode> lcm_;
   std::unique_ptr<MessageSink> lcm_sink_;
   std::unique_ptr<TickPipeline> pipeline_;
-  std::unique_ptr<CameraOutputs> camera_outputs_;  // with a camera: info and preview
   QueuedOutput queued_output_{*this};
   hal::MonotonicClock clock_;
   // Snapshots are large: a few slots cover the publisher thread waking late.
@@ -98,7 +96,7 @@ class Runtime {
   std::atomic<bool> rt_failed_{false};
   std::string rt_warnings_;
   std::thread loop_, pub_, lcmin_;
-  std::thread devices_[kMaxThreadDevices];
+  std::thread devices_[kMaxDeviceTypes];
 };
 
 }  // namespace rtfuse

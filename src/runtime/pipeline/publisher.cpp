@@ -7,6 +7,7 @@
 
 #include "geometry/rotation.hpp"
 #include "runtime/devices/device_layout.hpp"
+#include "runtime/devices/device_registry.hpp"
 #include "rtfuse/diagnostics_t.hpp"
 #include "rtfuse/filter_state_t.hpp"
 #include "rtfuse/navsat_fix_t.hpp"
@@ -152,7 +153,7 @@ struct Publisher::Impl {
   Output<rtfuse::diagnostics_t> diagnostics;
   Output<rtfuse::odometry_t> wheel_odometry;  // raw dead reckoning from the encoders
   std::int64_t last_wheel_stamp = -1;
-  HwName wheel_channel;
+  Name wheel_channel;
   std::array<std::int64_t, kMaxSensors> rejections_at_last_diagnostics{};
   std::int64_t encode_failures = 0;
 };
@@ -258,7 +259,7 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
   const WheelOdometrySection& w = c.hardware.wheel_odometry;
   m.wheel_channel = w.raw_channel;
   m.wheel_odometry.channel = m.wheel_channel.c_str();
-  m.wheel_odometry.schedule.set_rate(c.hardware.wheel_sensor >= 0 ? w.raw_rate_hz : 0.0);
+  m.wheel_odometry.schedule.set_rate(source_sensor(c, "wheel_odometry") >= 0 ? w.raw_rate_hz : 0.0);
   m.wheel_odometry.msg.header.frame_id = c.odom_frame.c_str();
   m.wheel_odometry.msg.child_frame_id = base;
   // Dead reckoning has no pose covariance worth the name: say "unknown" the

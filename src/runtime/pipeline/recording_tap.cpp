@@ -2,29 +2,42 @@
 
 #include <algorithm>
 
-#include "runtime/devices/camera/camera_calibration.hpp"
-
 namespace rtfuse {
 namespace {
 
-// Channel-safe: "/dev/i2c-1" -> "i2c-1", no '/' or spaces.
-std::string device_name(std::string_view path, const char* fallback) {
-  const std::size_t slash = path.rfind('/');
-  std::string name(slash == std::string_view::npos ? path : path.substr(slash + 1));
-  std::replace(name.begin(), name.end(), ' ', '_');
-  return name.empty() ? std::string(fallback) : name;
+transport::DeviceKind recorded_kind(BusKind k) noexcept {
+  switch (k) {
+    case BusKind::kCan: return transport::DeviceKind::kCan;
+    case BusKind::kI2c: return transport::DeviceKind::kI2c;
+    case BusKind::kEdge: return transport::DeviceKind::kGpioEdge;
+    case BusKind::kVideo: return transport::DeviceKind::kVideo;
+    case BusKind::kSerial: return transport::DeviceKind::kSerial;
+    case BusKind::kClock: break;
+  }
+  return transport::DeviceKind::kClock;
+}
+
+// The kinds of a device's buses that go into the recording, in table order.
+std::uint32_t recorded_buses(const DeviceDescriptor& d, const DeviceBuses& b) noexcept {
+  std::uint32_t kinds = b.present();
+  // A clock alone is no device's traffic, and some clocks decide nothing.
+  if (!d.records_clock() || kinds == bus_bit(BusKind::kClock)) kinds &= ~bus_bit(BusKind::kClock);
+  return kinds;
 }
 
 }  // namespace
 
-std::string can_device_name(const RuntimeConfig& cfg) {
-  return device_name(cfg.hardware.can.interface.view(), "can");
+const char* recording_stream(const DeviceDescriptor& d) noexcept {
+  return d.scheduling() == DeviceScheduling::kPolled ? kLoopStream : d.name();
 }
-std::string i2c_device_name(const RuntimeConfig& cfg) { return device_name(cfg.hardware.mpu.device.view(), "i2c"); }
-std::string video_device_name(const RuntimeConfig& cfg) {
-  return device_name(cfg.hardware.camera.device.view(), "video");
+
+std::string recorded_bus_name(const DeviceDescriptor& d, const RuntimeConfig& cfg, BusKind kind) {
+  switch (kind) {
+    case BusKind::kEdge: return std::string(d.name()) + "-drdy";
+    case BusKind::kClock: return std::string(d.name()) + "-clock";
+    default: return device_path_name(d.bus_path(cfg), d.name());
+  }
 }
-std::string gnss_device_name(const RuntimeConfig& cfg) { return device_name(cfg.hardware.gnss.device.view(), "gnss"); }
 
 RecordingTap::~RecordingTap() = default;
 
@@ -38,33 +51,33 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
   info.config_path = cfg.source;
   info.config_text = config_text;
   info.config_hash = transport::config_text_hash(config_text);
-  info.streams = {kLoopStream, kImuStream};
-  // The calibration travels with the recording: its replay needs no file.
-  const CameraSection& camera_section = cfg.hardware.camera;
-  if (camera_section.enabled && !camera_section.calibration_text.empty()) {
-    info.files.push_back({kCameraCalibrationKey, camera_section.calibration_file, camera_section.calibration_text});
-  }
-  // The camera's calls go through a ring of their own (frames are large), on
-  // a stream of their own; a configuration without one records as before.
-  if (inner.camera.video != nullptr) info.streams.push_back(kCameraStream);
-  int can = -1, i2c = -1, drdy = -1, imu_clock = -1;
-  auto add = [&info](std::string name, transport::DeviceKind kind, int stream) {
-    info.devices.push_back({std::move(name), kind, stream});
-    return static_cast<int>(info.devices.size()) - 1;
+  info.streams = {kLoopStream};
+  // Each device's buses: its stream and its entries in the device table.
+  struct Tapped {
+    int device;   // registry index
+    int stream;
+    int entry[kBusKinds];
   };
-  if (inner.can != nullptr) can = add(can_device_name(cfg), transport::DeviceKind::kCan, 0);
-  if (inner.imu.i2c != nullptr) i2c = add(i2c_device_name(cfg), transport::DeviceKind::kI2c, 1);
-  if (inner.imu.data_ready != nullptr) drdy = add("imu-drdy", transport::DeviceKind::kGpioEdge, 1);
-  if (inner.imu.clock != nullptr && inner.imu.i2c != nullptr) {
-    imu_clock = add("imu-clock", transport::DeviceKind::kClock, 1);
-  }
-  const int camera = inner.camera.video != nullptr ? add(video_device_name(cfg), transport::DeviceKind::kVideo, 2) : -1;
-  int gnss = -1, gnss_clock = -1, gnss_stream = -1;
-  if (inner.gnss.serial != nullptr && inner.gnss.clock != nullptr) {
-    gnss_stream = static_cast<int>(info.streams.size());
-    info.streams.push_back(kGnssStream);
-    gnss = add(gnss_device_name(cfg), transport::DeviceKind::kSerial, gnss_stream);
-    gnss_clock = add("gnss-clock", transport::DeviceKind::kClock, gnss_stream);
+  std::vector<Tapped> tapped;
+  for (int i = 0; i < device_type_count(); ++i) {
+    const DeviceDescriptor& d = device_type(i);
+    if (!d.enabled(cfg)) continue;
+    // The files a replay needs (the camera's calibration) travel along.
+    d.recorded_files(cfg, &info.files);
+    const std::uint32_t kinds = recorded_buses(d, inner.device[i]);
+    if (kinds == 0) continue;
+    Tapped tap{i, 0, {-1, -1, -1, -1, -1, -1}};
+    if (d.scheduling() != DeviceScheduling::kPolled) {
+      tap.stream = static_cast<int>(info.streams.size());
+      info.streams.push_back(d.name());
+    }
+    for (int k = 0; k < kBusKinds; ++k) {
+      if ((kinds & (1u << k)) == 0) continue;
+      const auto kind = static_cast<BusKind>(k);
+      info.devices.push_back({recorded_bus_name(d, cfg, kind), recorded_kind(kind), tap.stream});
+      tap.entry[k] = static_cast<int>(info.devices.size()) - 1;
+    }
+    tapped.push_back(tap);
   }
   runtime::RecorderRingSizes sizes;
   // A second of the loop at 1 kHz and of a 1 kHz IMU, so a writer stalled
@@ -75,55 +88,54 @@ std::unique_ptr<RecordingTap> RecordingTap::create(const std::string& path, cons
   t->recorder_ = runtime::Recorder::create(path, info, sizes, error);
   if (!t->recorder_) return nullptr;
   runtime::Recorder& r = *t->recorder_;
-  HalBuses& b = t->buses_;
-  if (can >= 0) {
-    t->can_ = std::make_unique<hal::RecordingCanBus>(*inner.can, r.ring(0), static_cast<std::uint8_t>(can), &clock);
-    b.can = t->can_.get();
-  }
-  if (i2c >= 0) {
-    t->i2c_ = std::make_unique<hal::RecordingI2cBus>(*inner.imu.i2c, r.ring(1), static_cast<std::uint8_t>(i2c), &clock);
-    b.imu.i2c = t->i2c_.get();
-  }
-  if (drdy >= 0) {
-    t->drdy_ =
-        std::make_unique<hal::RecordingEdgeSource>(*inner.imu.data_ready, r.ring(1), static_cast<std::uint8_t>(drdy), &clock);
-    b.imu.data_ready = t->drdy_.get();
-  }
-  if (imu_clock >= 0) {
-    t->imu_clock_ =
-        std::make_unique<hal::RecordingClock>(*inner.imu.clock, r.ring(1), static_cast<std::uint8_t>(imu_clock));
-    b.imu.clock = t->imu_clock_.get();
-  }
-  if (camera >= 0) {
-    // Eight frames (a quarter of a second at 30 fps) ride out a disk that
-    // stalls; beyond that the camera thread drops records, never waits.
-    hal::VideoRecordRing* ring = r.add_video_ring(2, inner.camera.video->format().image_size, 8, 0, error);
-    if (ring == nullptr) return nullptr;
-    t->camera_ = std::make_unique<hal::RecordingVideoStream>(*inner.camera.video, *ring,
-                                                             static_cast<std::uint8_t>(camera), &clock);
-    b.camera.video = t->camera_.get();
-    b.camera.clock = inner.camera.clock;
-  }
-  if (gnss >= 0) {
-    t->gnss_ = std::make_unique<hal::RecordingSerialPort>(*inner.gnss.serial, r.ring(gnss_stream),
-                                                          static_cast<std::uint8_t>(gnss), &clock);
-    t->gnss_clock_ = std::make_unique<hal::RecordingClock>(*inner.gnss.clock, r.ring(gnss_stream),
-                                                           static_cast<std::uint8_t>(gnss_clock));
-    b.gnss.serial = t->gnss_.get();
-    b.gnss.clock = t->gnss_clock_.get();
+  t->buses_ = inner;
+  for (const Tapped& tap : tapped) {
+    const DeviceBuses& in = inner.device[tap.device];
+    DeviceBuses& out = t->buses_.device[tap.device];
+    auto index = [&](BusKind k) { return static_cast<std::uint8_t>(tap.entry[static_cast<int>(k)]); };
+    auto has = [&](BusKind k) { return tap.entry[static_cast<int>(k)] >= 0; };
+    if (has(BusKind::kCan)) {
+      t->cans_.push_back(std::make_unique<hal::RecordingCanBus>(*in.can, r.ring(tap.stream), index(BusKind::kCan), &clock));
+      out.can = t->cans_.back().get();
+    }
+    if (has(BusKind::kI2c)) {
+      t->i2cs_.push_back(std::make_unique<hal::RecordingI2cBus>(*in.i2c, r.ring(tap.stream), index(BusKind::kI2c), &clock));
+      out.i2c = t->i2cs_.back().get();
+    }
+    if (has(BusKind::kEdge)) {
+      t->edges_.push_back(
+          std::make_unique<hal::RecordingEdgeSource>(*in.edge, r.ring(tap.stream), index(BusKind::kEdge), &clock));
+      out.edge = t->edges_.back().get();
+    }
+    if (has(BusKind::kVideo)) {
+      // Eight frames (a quarter of a second at 30 fps) ride out a disk that
+      // stalls; beyond that the camera thread drops records, never waits.
+      hal::VideoRecordRing* ring = r.add_video_ring(tap.stream, in.video->format().image_size, 8, 0, error);
+      if (ring == nullptr) return nullptr;
+      t->videos_.push_back(std::make_unique<hal::RecordingVideoStream>(*in.video, *ring, index(BusKind::kVideo), &clock));
+      out.video = t->videos_.back().get();
+    }
+    if (has(BusKind::kSerial)) {
+      t->serials_.push_back(
+          std::make_unique<hal::RecordingSerialPort>(*in.serial, r.ring(tap.stream), index(BusKind::kSerial), &clock));
+      out.serial = t->serials_.back().get();
+    }
+    if (has(BusKind::kClock)) {
+      t->clocks_.push_back(std::make_unique<hal::RecordingClock>(*in.clock, r.ring(tap.stream), index(BusKind::kClock)));
+      out.clock = t->clocks_.back().get();
+    }
   }
   return t;
 }
 
 std::int64_t RecordingTap::overflows() const {
   std::int64_t n = 0;
-  if (can_) n += can_->overflows();
-  if (i2c_) n += i2c_->overflows();
-  if (drdy_) n += drdy_->overflows();
-  if (imu_clock_) n += imu_clock_->overflows();
-  if (camera_) n += camera_->overflows();
-  if (gnss_) n += gnss_->overflows();
-  if (gnss_clock_) n += gnss_clock_->overflows();
+  for (const auto& b : cans_) n += b->overflows();
+  for (const auto& b : i2cs_) n += b->overflows();
+  for (const auto& b : edges_) n += b->overflows();
+  for (const auto& b : videos_) n += b->overflows();
+  for (const auto& b : serials_) n += b->overflows();
+  for (const auto& b : clocks_) n += b->overflows();
   return n;
 }
 

@@ -1,17 +1,18 @@
 #pragma once
 // rtfused --record: the recorder plus the recording decorators around the
 // configuration's buses. The drivers are given buses() instead of the real
-// ones and never know they are recorded. Which device is on which thread is
-// fixed here and read back by hal_replay.cpp:
-//   stream "loop": the CAN bus (polled inside the tick);
-//   stream "imu":  the I2C bus, the data-ready line, the IMU thread's clock;
-//   stream "camera": the camera's video stream (frames in a ring of their
-//   own; the camera thread's clock is not recorded: its driver reads it only
-//   to back off while the camera is unplugged);
-//   stream "gnss": the receiver's serial port and the GNSS thread's clock
-//   (its silence and reopen backoff are decided on it).
+// ones and never know they are recorded. Every registered device's buses
+// are recorded the same way, on the stream of the thread that calls them:
+//   stream "loop": the buses of the polled devices (the CAN encoders);
+//   stream "<device>": a thread device's buses (the IMU's I2C bus, data-ready
+//   line and clock; the GNSS receiver's serial port and clock), a camera's
+//   video stream with its frames in a ring of its own. A clock is recorded
+//   unless the descriptor says its reads decide nothing (the camera's, read
+//   only to back off while it is unplugged).
+// The replay (replay/) reads the same layout back from the device table.
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "hal/recording_can_bus.hpp"
 #include "hal/recording_clock.hpp"
@@ -25,12 +26,16 @@
 
 namespace rtfuse {
 
-// Streams are named after their thread: the loop, and each thread device
-// by its name() (the IMU's is "imu").
+// The polled devices' stream; a thread device's is named after it.
 constexpr const char* kLoopStream = "loop";
-constexpr const char* kImuStream = "imu";
-constexpr const char* kCameraStream = "camera";
-constexpr const char* kGnssStream = "gnss";
+
+// The recording stream of a registered device.
+const char* recording_stream(const DeviceDescriptor& d) noexcept;
+// The name a recording's device table gives bus `kind` of a device: its
+// device path's last part for its main bus ("can0", "i2c-1", "video0",
+// "ttyACM0"), "<device>-drdy" and "<device>-clock" for a data-ready line
+// and a clock.
+std::string recorded_bus_name(const DeviceDescriptor& d, const RuntimeConfig& cfg, BusKind kind);
 
 class RecordingTap {
  public:
@@ -51,20 +56,13 @@ class RecordingTap {
  private:
   RecordingTap() = default;
   std::unique_ptr<runtime::Recorder> recorder_;
-  std::unique_ptr<hal::RecordingCanBus> can_;
-  std::unique_ptr<hal::RecordingI2cBus> i2c_;
-  std::unique_ptr<hal::RecordingEdgeSource> drdy_;
-  std::unique_ptr<hal::RecordingClock> imu_clock_;
-  std::unique_ptr<hal::RecordingVideoStream> camera_;
-  std::unique_ptr<hal::RecordingSerialPort> gnss_;
-  std::unique_ptr<hal::RecordingClock> gnss_clock_;
+  std::vector<std::unique_ptr<hal::RecordingCanBus>> cans_;
+  std::vector<std::unique_ptr<hal::RecordingI2cBus>> i2cs_;
+  std::vector<std::unique_ptr<hal::RecordingEdgeSource>> edges_;
+  std::vector<std::unique_ptr<hal::RecordingVideoStream>> videos_;
+  std::vector<std::unique_ptr<hal::RecordingSerialPort>> serials_;
+  std::vector<std::unique_ptr<hal::RecordingClock>> clocks_;
   HalBuses buses_;
 };
-
-// The device names a recording uses for a configuration's buses.
-std::string can_device_name(const RuntimeConfig& cfg);
-std::string i2c_device_name(const RuntimeConfig& cfg);
-std::string video_device_name(const RuntimeConfig& cfg);
-std::string gnss_device_name(const RuntimeConfig& cfg);
 
 }  // namespace rtfuse

@@ -1,6 +1,6 @@
 #include "runtime/pipeline/tick_pipeline.hpp"
 
-#include "runtime/devices/camera/camera_calibration.hpp"
+#include "runtime/devices/device_registry.hpp"
 
 namespace rtfuse {
 
@@ -9,11 +9,15 @@ TickPipeline::~TickPipeline() = default;
 std::unique_ptr<TickPipeline> TickPipeline::create(const RuntimeConfig& cfg, const HalBuses& buses_in,
                                                    const PipelineOptions& options, std::string* error) {
   std::unique_ptr<TickPipeline> p(new TickPipeline());
-  // The camera's calibration is read once, here: the driver and the
-  // recording then hold the same bytes.
+  // Files a device names (the camera's calibration) are read once, here:
+  // the driver and the recording then hold the same bytes.
   RuntimeConfig resolved = cfg;
-  if (resolved.hardware.camera.enabled && !resolve_camera_calibration(&resolved.hardware.camera, error)) {
-    return nullptr;
+  bool any_device = false;
+  for (int i = 0; i < device_type_count(); ++i) {
+    const DeviceDescriptor& d = device_type(i);
+    if (!d.enabled(resolved)) continue;
+    any_device = true;
+    if (!d.prepare(resolved, error)) return nullptr;
   }
   p->core_ = FusionCore::create(resolved, error);
   if (!p->core_) return nullptr;
@@ -28,8 +32,7 @@ std::unique_ptr<TickPipeline> TickPipeline::create(const RuntimeConfig& cfg, con
     if (!p->tap_) return nullptr;
     buses = p->tap_->buses();
   }
-  const HardwareConfig& hw = p->core_->config().hardware;
-  if (hw.can.enabled || hw.mpu.enabled || hw.camera.enabled || hw.gnss.enabled) {
+  if (any_device) {
     p->hardware_ = Hardware::create(buses, *p->core_, error);
     if (!p->hardware_) return nullptr;
     p->core_->set_devices(p->hardware_.get());

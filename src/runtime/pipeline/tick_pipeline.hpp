@@ -75,7 +75,8 @@ class TickPipeline {
   MessageSink& sink() { return *sink_; }
   Hardware* hardware() { return hardware_.get(); }
   int thread_device_count() const { return hardware_ ? hardware_->thread_device_count() : 0; }
-  ThreadDevice& thread_device(int i) { return hardware_->thread_device(i); }
+  Device& thread_device(int i) { return hardware_->thread_device(i); }
+  const char* thread_device_name(int i) const { return hardware_->thread_device_name(i); }
   RecordingTap* tap() { return tap_.get(); }
   const RecordingTap* tap() const { return tap_.get(); }
   // The time the devices were started with.

@@ -7,6 +7,7 @@
 
 #include <cstdint>
 #include <cstring>
+#include <iterator>
 #include <memory>
 #include <string>
 
@@ -70,10 +71,10 @@ struct CameraRig {
     if (!r.config) return;
     core = FusionCore::create(*r.config, &error);
     if (!core) return;
-    CameraBuses buses;
+    DeviceBuses buses;
     buses.video = &stream;
     buses.clock = &clock;
-    camera = CameraDevice::create(buses, *core, 0, -1, &error);
+    camera = CameraDevice::create(buses, *core, 0, false, &error);
     s.num_devices = describe_devices(core->config(), s.devices, kMaxDevices);
   }
   const DeviceStatus& status() {
@@ -94,12 +95,13 @@ TEST(CameraDevice, StatusCarriesEveryCounterAndThePairsDigest) {
   CameraRig rig;
   ASSERT_TRUE(rig.camera) << rig.error;
   ASSERT_EQ(rig.s.num_devices, 1);
-  EXPECT_LE(kCameraKeyCount, kMaxDeviceValues);
+  const int key_count = static_cast<int>(std::size(kCameraKeys));
+  EXPECT_LE(key_count, kMaxDeviceValues);
   for (int i = 0; i < 3; ++i) rig.camera->step(2 * kPeriod);
   const DeviceStatus& d = rig.status();
   EXPECT_STREQ(d.name.c_str(), "camera");
-  EXPECT_EQ(d.num_values, kCameraKeyCount) << "every key has its value";
-  EXPECT_STREQ(d.keys[kCameraKeyCount - 1], "pairs_digest");
+  EXPECT_EQ(d.num_values, key_count) << "every key has its value";
+  EXPECT_STREQ(d.keys[key_count - 1], "pairs_digest");
   EXPECT_EQ(value(d, "frames"), 3);
   const std::uint64_t digest = rig.camera->stats().pairs_digest;
   EXPECT_NE(digest, 0u);

@@ -320,6 +320,7 @@ TEST(FusionCore, SteadyStateTicksDoNotAllocate) {
 class FakeWheels final : public TickDevices {
  public:
   explicit FakeWheels(FusionCore& core) : core_(core) {}
+  int slot_count() const noexcept override { return 0; }
   void before_drain(TimeNs now) noexcept override {
     ++polls;
     if (polls % 2 != 0) return;  // a sample every other tick, like a slower SYNC

@@ -11,6 +11,7 @@
 #include "hal/mock/mock_serial_port.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "runtime/config/config_loader.hpp"
+#include "runtime/devices/device_layout.hpp"
 #include "support/alloc_counter.hpp"
 #include "support/gnss_bytes.hpp"
 
@@ -68,8 +69,11 @@ struct Rig {
     std::string err;
     core = FusionCore::create(*r.config, &err);
     EXPECT_TRUE(core) << err;
-    slots = device_slots(core->config());
-    device = GnssDevice::create(GnssBuses{&port, &clock}, *core, slots.gnss, &err);
+    slot = device_layout(core->config()).first_slot[find_device_type("gnss")];
+    DeviceBuses buses;
+    buses.serial = &port;
+    buses.clock = &clock;
+    device = GnssDevice::create(buses, *core, slot, &err);
     EXPECT_TRUE(device) << err;
   }
   void feed(const std::vector<std::uint8_t>& b, TimeNs at) {
@@ -92,7 +96,7 @@ struct Rig {
   DeviceStatus status() {
     Snapshot s;
     device->fill_snapshot(s);
-    return s.devices[slots.gnss];
+    return s.devices[slot];
   }
   std::int64_t value(const DeviceStatus& d, const char* key) {
     for (int i = 0; i < d.num_values; ++i) {
@@ -104,7 +108,7 @@ struct Rig {
   hal::mock::SimClock clock{1000 * kMs};
   hal::mock::MockSerialPort port{clock};
   std::unique_ptr<FusionCore> core;
-  DeviceSlots slots;
+  int slot = -1;
   std::unique_ptr<GnssDevice> device;
 };
 

@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include "runtime/config/config_loader.hpp"
+#include "runtime/devices/device_registry.hpp"
 
 namespace rtfuse {
 namespace {
@@ -119,9 +120,9 @@ TEST(HardwareConfig, FullRobotLandsInTheStructures) {
   EXPECT_EQ(hw.mpu.data_ready_line, 160);
   EXPECT_EQ(hw.mpu.attitude.algorithm, AttitudeAlgorithmConfig::kMahony);
   EXPECT_DOUBLE_EQ(hw.mpu.attitude.ki, 0.05);
-  EXPECT_EQ(hw.wheel_sensor, 0);
-  EXPECT_EQ(hw.mpu_sensor, 1);
-  EXPECT_EQ(r.config->sensors[0].source, SensorSource::kWheelOdometry);
+  EXPECT_EQ(source_sensor(*r.config, "wheel_odometry"), 0);
+  EXPECT_EQ(source_sensor(*r.config, "mpu"), 1);
+  EXPECT_EQ(r.config->sensors[0].source, find_device_source("wheel_odometry"));
   EXPECT_TRUE(r.config->sensors[0].channel.empty());
 }
 

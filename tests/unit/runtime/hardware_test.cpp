@@ -4,6 +4,7 @@
 // the snapshot's devices, faults show and recover, and the steady state
 // allocates nothing.
 #include "runtime/devices/hardware.hpp"
+#include "runtime/devices/imu/imu_device.hpp"
 
 #include <cmath>
 #include <cstring>
@@ -167,7 +168,7 @@ struct CanRig {
     EXPECT_TRUE(bus.attach(left));
     EXPECT_TRUE(bus.attach(right));
     HalBuses buses;
-    buses.can = &bus;
+    buses.of("wheel_encoders").can = &bus;
     hardware = Hardware::create(buses, *core, &err);
     EXPECT_TRUE(hardware) << err;
     if (!hardware) return;
@@ -388,9 +389,9 @@ struct ImuRig {
   }
   bool start() {
     HalBuses buses;
-    buses.imu.i2c = &i2c;
-    buses.imu.data_ready = &edges;
-    buses.imu.clock = &clock;
+    buses.of("imu").i2c = &i2c;
+    buses.of("imu").edge = &edges;
+    buses.of("imu").clock = &clock;
     hardware = Hardware::create(buses, *core, &error);
     if (!hardware) return false;
     core->set_devices(hardware.get());
@@ -412,7 +413,7 @@ struct ImuRig {
     const double gyro[3] = {0.0, 0.0, yaw_rate};
     if (!chip.set_sample(accel, gyro, 25.0)) ++chip_refused;
     edges.push(t);
-    const drivers::StepResult r = hardware->imu()->step_imu(kDeviceStepTimeoutNs);
+    const drivers::StepResult r = hardware->find<ImuDevice>("imu")->step_imu(kDeviceStepTimeoutNs);
     clock.set(t);
     ++loop.ticks;
     core->tick(t, loop);
@@ -441,13 +442,13 @@ TEST(Hardware, ImuYawRateReachesTheEstimate) {
   ImuRig rig(std::string(kFilter) + kMpu + kImuMount);
   ASSERT_TRUE(rig.core);
   ASSERT_TRUE(rig.start()) << rig.error;
-  ASSERT_TRUE(rig.hardware->imu() != nullptr);
+  ASSERT_TRUE(rig.hardware->find<ImuDevice>("imu") != nullptr);
   constexpr double kRate = 0.5;  // rad/s, above the standstill threshold
   int samples = 0;
   for (int i = 0; i < 400; ++i) samples += rig.step(kRate) == drivers::StepResult::kSample;
   EXPECT_EQ(rig.chip_refused, 0) << "data-ready was not enabled by the driver";
   EXPECT_EQ(samples, 400);
-  EXPECT_EQ(rig.hardware->imu()->samples(), 400);
+  EXPECT_EQ(rig.hardware->find<ImuDevice>("imu")->samples(), 400);
   const Snapshot& s = rig.snap();
   ASSERT_TRUE(s.initialized);
   EXPECT_TRUE(all_finite(s));

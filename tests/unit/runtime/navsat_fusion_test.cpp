@@ -135,8 +135,7 @@ struct Drive {
     return s;
   }
   const DeviceStatus& navsat_device(const Snapshot& s) const {
-    const DeviceSlots slots = device_slots(core->config());
-    return s.devices[slots.first_navsat];
+    return s.devices[device_layout(core->config()).device_slots];
   }
   std::int64_t value(const DeviceStatus& d, const char* key) const {
     for (int i = 0; i < d.num_values; ++i) {

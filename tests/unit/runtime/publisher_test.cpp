@@ -1,9 +1,12 @@
 #include "runtime/pipeline/publisher.hpp"
 #include "runtime/devices/device_layout.hpp"
+#include "runtime/devices/device_registry.hpp"
+#include "runtime/devices/wheel_encoders/wheel_encoder_device.hpp"
 
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <iterator>
 #include <map>
 #include <string>
 #include <vector>
@@ -332,23 +335,24 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   hw.can.nodes[0].node_id = 1;
   hw.can.nodes[1].node_id = 2;
   hw.can.nodes[1].side = WheelSideConfig::kRight;
-  hw.wheel_sensor = 0;
+  hw.source_sensor[find_device_source("wheel_odometry")] = 0;
   hw.mpu.enabled = true;
-  hw.mpu_sensor = 1;
+  hw.source_sensor[find_device_source("mpu")] = 1;
   Publisher pub(cfg);
 
   Snapshot s = known_snapshot();
   s.num_devices = describe_devices(cfg, s.devices, kMaxDevices);
   ASSERT_EQ(s.num_devices, 5);  // bus, 2 nodes, wheel odometry, imu
-  const DeviceSlots slots = device_slots(cfg);
-  DeviceStatus& right = s.devices[slots.first_node + 1];
+  const int can = device_layout(cfg).first_slot[find_device_type("wheel_encoders")];
+  const int imu = device_layout(cfg).first_slot[find_device_type("imu")];
+  DeviceStatus& right = s.devices[can + 2];  // after the bus and the left node
   right.level = DeviceLevel::kError;
   right.state = "silent";
   right.values[0] = 123456;  // counts
   right.values[5] = 2;       // silent_events
   set_device_message(right.message, "node 2: no heartbeat for more than 350 ms");
-  s.devices[slots.imu].level = DeviceLevel::kOk;
-  s.devices[slots.imu].state = "sampling";
+  s.devices[imu].level = DeviceLevel::kOk;
+  s.devices[imu].state = "sampling";
 
   CaptureSink sink;
   pub.poll(s, 1000 * kMs, sink);
@@ -360,7 +364,7 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
   EXPECT_EQ(d.devices[2].hardware_id, "can0 node 0x02");
   EXPECT_EQ(d.devices[2].level, kError);
   EXPECT_EQ(d.devices[2].state, "silent");
-  ASSERT_EQ(d.devices[2].num_values, kEncoderNodeKeyCount);
+  ASSERT_EQ(d.devices[2].num_values, static_cast<int>(std::size(kEncoderNodeKeys)));
   EXPECT_EQ(d.devices[2].keys[0], "counts");
   EXPECT_EQ(d.devices[2].values[0], 123456);
   EXPECT_EQ(d.devices[2].keys[5], "silent_events");
@@ -405,7 +409,7 @@ TEST(Publisher, DeviceStatusesFollowTheSnapshot) {
 TEST(Publisher, RawWheelOdometryOncePerNewSample) {
   RuntimeConfig cfg = two_sensor_config();
   cfg.hardware.can.enabled = true;
-  cfg.hardware.wheel_sensor = 0;
+  cfg.hardware.source_sensor[find_device_source("wheel_odometry")] = 0;
   cfg.hardware.wheel_odometry.raw_rate_hz = 1000.0;
   Publisher pub(cfg);
   CaptureSink sink;

@@ -221,7 +221,7 @@ TEST_F(HalReplay, ChangedSyncMidDriveStopsThereNotLater) {
 }
 
 TEST_F(HalReplay, ChangedImuByteChangesTheOutputsWithoutDivergence) {
-  const int imu = stream(kImuStream);
+  const int imu = stream("imu");
   // A data burst (ACCEL_XOUT_H, 14 bytes) mid-drive; flip gyro z by 256 LSB
   // (7.8 deg/s at 500 deg/s full scale): the same calls, another value.
   const std::size_t i = find(imu, BusEventKind::kI2cRead, 500, [](const BusEvent& ev) {

@@ -14,7 +14,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "rtfuse/camera_info_t.hpp"
 #include "rtfuse/image_t.hpp"
-#include "runtime/devices/camera/camera_outputs.hpp"
+#include "runtime/devices/camera/camera_device.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/pipeline/tick_pipeline.hpp"
 #include "sim/simulated_robot.hpp"
@@ -182,10 +182,10 @@ TEST(SimCamera, PreviewAndCameraInfoOfTheNewestPair) {
   auto pipeline = TickPipeline::create(*r.config, robot->buses(), options, &err);
   ASSERT_TRUE(pipeline) << err;
   ASSERT_TRUE(pipeline->start(t0, &err)) << err;
-  CameraDevice* camera = pipeline->hardware()->camera();
+  CameraDevice* camera = pipeline->hardware()->find<CameraDevice>("camera");
   ASSERT_NE(camera, nullptr);
-  auto outputs = CameraOutputs::create(*camera, r.config->hardware.camera, &err);
-  ASSERT_TRUE(outputs) << err;
+  // The device's own outputs, as the live publisher thread asks for them.
+  CameraDevice* outputs = camera;
   CapturingSink sink;
   // No pair yet: nothing to show.
   outputs->publish_due(t0, sink);

@@ -4,13 +4,12 @@
 
 namespace rtfuse {
 
-std::unique_ptr<CameraOutputs> CameraOutputs::create(CameraDevice& camera, const CameraSection& config,
-                                                     std::string* error) {
-  std::unique_ptr<CameraOutputs> o(new CameraOutputs(camera, config));
-  const drivers::StereoRectification& r = camera.rectified();
+std::unique_ptr<CameraOutputs> CameraOutputs::create(FramePool& pool, const drivers::StereoRectification& r,
+                                                     const CameraSection& config, std::string* error) {
+  std::unique_ptr<CameraOutputs> o(new CameraOutputs(pool, config));
   transport::StereoCameraModel model;
-  model.width = camera.pool().width();
-  model.height = camera.pool().height();
+  model.width = pool.width();
+  model.height = pool.height();
   model.fx = r.fx;
   model.fy = r.fy;
   model.cx = r.cx;
@@ -33,9 +32,9 @@ std::unique_ptr<CameraOutputs> CameraOutputs::create(CameraDevice& camera, const
   return o;
 }
 
-void CameraOutputs::publish_due(TimeNs now, MessageSink& sink) noexcept {
+void CameraOutputs::publish_due(TimeNs now, transport::MessageSink& sink) noexcept {
   if (period_ == 0 || now < next_) return;
-  FramePool& pool = camera_.pool();
+  FramePool& pool = pool_;
   FramePool::Handle h = pool.take_latest(last_frame_);
   if (!h.valid()) return;  // no new pair yet: look again at the next wake
   // The period counts from this preview: a stalled camera gives no burst.

@@ -9,8 +9,10 @@
 #include <memory>
 #include <string>
 
-#include "runtime/devices/camera/camera_device.hpp"
-#include "runtime/pipeline/publisher.hpp"
+#include "core/frame_pool.hpp"
+#include "drivers/camera/stereo_rectification.hpp"
+#include "runtime/config/config.hpp"
+#include "transport/message_sink.hpp"
 #include "transport/camera_messages.hpp"
 
 namespace rtfuse {
@@ -18,17 +20,17 @@ namespace rtfuse {
 class CameraOutputs {
  public:
   // Null with *error when the encoders refuse the camera's geometry.
-  static std::unique_ptr<CameraOutputs> create(CameraDevice& camera, const CameraSection& config,
-                                               std::string* error);
+  static std::unique_ptr<CameraOutputs> create(FramePool& pool, const drivers::StereoRectification& rectified,
+                                               const CameraSection& config, std::string* error);
   // Publisher thread: when due, the newest pair's preview and both camera
   // infos (stamped with its capture time). No allocation.
-  void publish_due(TimeNs now, MessageSink& sink) noexcept;
+  void publish_due(TimeNs now, transport::MessageSink& sink) noexcept;
   std::int64_t published() const noexcept { return published_; }
 
  private:
-  CameraOutputs(CameraDevice& camera, const CameraSection& config) : camera_(camera), config_(config) {}
+  CameraOutputs(FramePool& pool, const CameraSection& config) : pool_(pool), config_(config) {}
 
-  CameraDevice& camera_;
+  FramePool& pool_;
   const CameraSection& config_;
   std::unique_ptr<transport::CameraInfoEncoder> info_;
   std::unique_ptr<transport::PreviewEncoder> preview_;

@@ -3,7 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "runtime/devices/device_registry.hpp"
+
 namespace rtfuse {
+
+const char* const kGnssKeys[14] = {"epochs",     "fixes",   "no_fix",      "two_d", "dead_reckoning",
+                                   "time_jumps", "refused", "lost_epochs", "bytes", "read_errors",
+                                   "silent_events", "reopens", "satellites", "hdop_milli"};
 
 drivers::GnssReceiverConfig gnss_driver_config(const GnssSection& g) noexcept {
   drivers::GnssReceiverConfig c;
@@ -37,14 +43,14 @@ void gnss_fix_to_sample(const drivers::GnssFix& fix, TimeNs latency_ns, est::Sen
   }
 }
 
-GnssDevice::GnssDevice(const GnssBuses& buses, FusionCore& core, int device_slot)
+GnssDevice::GnssDevice(const DeviceBuses& buses, FusionCore& core, int device_slot)
     : core_(core),
       port_(*buses.serial),
       clock_(*buses.clock),
-      sensor_(core.config().hardware.gnss_sensor),
+      sensor_(source_sensor(core.config(), "gnss")),
       slot_(device_slot) {}
 
-std::unique_ptr<GnssDevice> GnssDevice::create(const GnssBuses& buses, FusionCore& core, int device_slot,
+std::unique_ptr<GnssDevice> GnssDevice::create(const DeviceBuses& buses, FusionCore& core, int device_slot,
                                                std::string* error) {
   if (buses.serial == nullptr || buses.clock == nullptr) {
     *error = "[gnss] is configured but the HAL has no serial port for it";
@@ -109,7 +115,7 @@ void GnssDevice::fill_snapshot(Snapshot& s) noexcept {
   health_.load(h);
   DeviceStatus& d = s.devices[slot_];
   const drivers::GnssReceiverStats& st = h.stats;
-  set_device_values(d, kGnssKeys, kGnssKeyCount,
+  set_device_values(d, kGnssKeys,
                     {st.epochs, st.epochs - st.no_fix_epochs, st.no_fix_epochs, st.two_d, st.dead_reckoning,
                      st.time_jumps, st.refused, st.lost_epochs, st.bytes, st.read_errors, st.silent_events, h.reopens,
                      h.satellites, h.hdop < 0 ? -1 : static_cast<std::int64_t>(std::lround(h.hdop * 1000.0))});

@@ -11,10 +11,9 @@
 
 #include "core/seqlock.hpp"
 #include "drivers/gnss/gnss_receiver.hpp"
-#include "runtime/devices/device_layout.hpp"
+#include "runtime/devices/device.hpp"
+#include "runtime/devices/device_buses.hpp"
 #include "runtime/fusion/fusion_core.hpp"
-#include "runtime/devices/hal_buses.hpp"
-#include "runtime/devices/thread_device.hpp"
 
 namespace rtfuse {
 
@@ -25,13 +24,16 @@ drivers::GnssReceiverConfig gnss_driver_config(const GnssSection& g) noexcept;
 // gets a vertical variance that says it is unknown.
 void gnss_fix_to_sample(const drivers::GnssFix& fix, TimeNs latency_ns, est::SensorSample* out) noexcept;
 
-class GnssDevice final : public ThreadDevice {
+// The receiver's epochs and faults (drivers::GnssReceiverStats); hdop_milli
+// the last epoch's HDOP x1000 (-1 unknown).
+extern const char* const kGnssKeys[14];
+
+class GnssDevice final : public Device {
  public:
   // The configuration is the core's; buses.serial and buses.clock are required.
-  static std::unique_ptr<GnssDevice> create(const GnssBuses& buses, FusionCore& core, int device_slot,
+  static std::unique_ptr<GnssDevice> create(const DeviceBuses& buses, FusionCore& core, int device_slot,
                                             std::string* error);
 
-  const char* name() const noexcept override { return "gnss"; }
   void step(TimeNs timeout_ns) noexcept override;
   int sensor() const noexcept override { return sensor_; }
   std::int64_t samples() const noexcept override { return samples_.load(std::memory_order_acquire); }
@@ -40,7 +42,7 @@ class GnssDevice final : public ThreadDevice {
   const drivers::GnssReceiver& receiver() const noexcept { return *receiver_; }
 
  private:
-  GnssDevice(const GnssBuses& buses, FusionCore& core, int device_slot);
+  GnssDevice(const DeviceBuses& buses, FusionCore& core, int device_slot);
   // The port is gone: reopen it when the backoff allows, else wait for that.
   void recover(TimeNs timeout_ns) noexcept;
 

@@ -2,7 +2,13 @@
 
 #include <cmath>
 
+#include "runtime/devices/device_registry.hpp"
+
 namespace rtfuse {
+
+const char* const kImuKeys[13] = {"samples",   "reads",     "nacks",          "bus_errors",       "timeouts",
+                                  "frozen",    "saturated", "impossible",     "missing_edges",    "out_of_order_edges",
+                                  "reinits",   "filter_rejects", "temperature_mdegc"};
 
 bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& frames, drivers::MpuImuConfig* out,
                        std::string* error) {
@@ -45,9 +51,9 @@ bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& fram
 }
 
 ImuDevice::ImuDevice(FusionCore& core, int device_slot)
-    : core_(core), sensor_(core.config().hardware.mpu_sensor), slot_(device_slot) {}
+    : core_(core), sensor_(source_sensor(core.config(), "mpu")), slot_(device_slot) {}
 
-std::unique_ptr<ImuDevice> ImuDevice::create(const ImuBuses& buses, FusionCore& core, int device_slot,
+std::unique_ptr<ImuDevice> ImuDevice::create(const DeviceBuses& buses, FusionCore& core, int device_slot,
                                              std::string* error) {
   if (buses.i2c == nullptr || buses.clock == nullptr) {
     *error = "[mpu] is configured but the HAL has no I2C bus";
@@ -56,7 +62,7 @@ std::unique_ptr<ImuDevice> ImuDevice::create(const ImuBuses& buses, FusionCore& 
   drivers::MpuImuConfig icfg;
   if (!imu_driver_config(core.config(), core.frames(), &icfg, error)) return nullptr;
   std::unique_ptr<ImuDevice> d(new ImuDevice(core, device_slot));
-  d->imu_ = std::make_unique<drivers::MpuImu>(icfg, *buses.i2c, buses.data_ready, *buses.clock);
+  d->imu_ = std::make_unique<drivers::MpuImu>(icfg, *buses.i2c, buses.edge, *buses.clock);
   // Samples of driver-fed sensors are in base_link: the driver rotates.
   d->sample_.sensor = static_cast<std::uint8_t>(d->sensor_ < 0 ? 0 : d->sensor_);
   d->sample_.kind = est::SensorKind::kImu;
@@ -65,7 +71,7 @@ std::unique_ptr<ImuDevice> ImuDevice::create(const ImuBuses& buses, FusionCore& 
   return d;
 }
 
-bool ImuDevice::start(std::string* error) {
+bool ImuDevice::start(TimeNs, std::string* error) {
   if (imu_->start()) return true;
   *error = std::string("IMU: ") + imu_->error();
   return false;
@@ -107,7 +113,7 @@ void ImuDevice::fill_snapshot(Snapshot& s) noexcept {
   health_.load(h);
   DeviceStatus& d = s.devices[slot_];
   const drivers::MpuImuStats& st = h.stats;
-  set_device_values(d, kImuKeys, kImuKeyCount,
+  set_device_values(d, kImuKeys,
                     {st.samples, st.reads, st.nacks, st.bus_errors + st.io_errors, st.timeouts, st.frozen,
                      st.saturated, st.impossible, st.missing_edges, st.out_of_order_edges, st.reinits,
                      st.filter_rejects, static_cast<std::int64_t>(std::lround(h.temperature_c * 1000.0))});

@@ -8,10 +8,9 @@
 
 #include "core/seqlock.hpp"
 #include "drivers/imu/mpu_imu.hpp"
-#include "runtime/devices/device_layout.hpp"
+#include "runtime/devices/device.hpp"
+#include "runtime/devices/device_buses.hpp"
 #include "runtime/fusion/fusion_core.hpp"
-#include "runtime/devices/hal_buses.hpp"
-#include "runtime/devices/thread_device.hpp"
 
 namespace rtfuse {
 
@@ -19,16 +18,17 @@ namespace rtfuse {
 bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& frames, drivers::MpuImuConfig* out,
                        std::string* error);
 
-class ImuDevice final : public ThreadDevice {
+extern const char* const kImuKeys[13];
+
+class ImuDevice final : public Device {
  public:
-  // The configuration is the core's; buses.i2c and buses.clock are required.
-  static std::unique_ptr<ImuDevice> create(const ImuBuses& buses, FusionCore& core, int device_slot,
+  // The configuration is the core's; buses.i2c and buses.clock are required,
+  // buses.edge is the data-ready line (null: poll).
+  static std::unique_ptr<ImuDevice> create(const DeviceBuses& buses, FusionCore& core, int device_slot,
                                            std::string* error);
 
   // Before the threads: identity check and configuration of the chip.
-  bool start(std::string* error);
-
-  const char* name() const noexcept override { return "imu"; }
+  bool start(TimeNs now, std::string* error) override;
   void step(TimeNs timeout_ns) noexcept override { step_imu(timeout_ns); }
   int sensor() const noexcept override { return sensor_; }
   std::int64_t samples() const noexcept override { return samples_.load(std::memory_order_acquire); }

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "runtime/devices/device_registry.hpp"
+
 namespace rtfuse {
 namespace {
 
@@ -19,6 +21,13 @@ DeviceLevel encoder_level(drivers::EncoderHealth h) noexcept {
 }
 
 }  // namespace
+
+const char* const kCanBusKeys[7] = {"frames_received", "syncs_sent",   "send_failures", "malformed_frames",
+                                    "unexpected_cob_ids", "error_frames", "bus_off_events"};
+const char* const kEncoderNodeKeys[10] = {"counts",         "tpdos",         "heartbeats",   "emcy",
+                                          "last_emcy_code", "silent_events", "stuck_events", "jump_events",
+                                          "recoveries",     "nmt_starts"};
+const char* const kWheelOdometryKeys[3] = {"twists", "no_side", "reseeds"};
 
 drivers::CanopenEncodersConfig encoder_driver_config(const RuntimeConfig& cfg) {
   const CanSection& can = cfg.hardware.can;
@@ -72,21 +81,21 @@ drivers::WheelOdometryConfig wheel_driver_config(const RuntimeConfig& cfg) {
   return d;
 }
 
-WheelEncoderDevice::WheelEncoderDevice(FusionCore& core, const DeviceSlots& slots)
-    : cfg_(core.config()), core_(core), slots_(slots) {}
+WheelEncoderDevice::WheelEncoderDevice(FusionCore& core, int first_slot)
+    : cfg_(core.config()), core_(core), first_slot_(first_slot), sensor_(source_sensor(core.config(), "wheel_odometry")) {}
 
-std::unique_ptr<WheelEncoderDevice> WheelEncoderDevice::create(hal::CanBus& bus, FusionCore& core,
-                                                               const DeviceSlots& slots, std::string* error) {
+std::unique_ptr<WheelEncoderDevice> WheelEncoderDevice::create(hal::CanBus& bus, FusionCore& core, int first_slot,
+                                                               std::string* error) {
   const RuntimeConfig& cfg = core.config();
-  std::unique_ptr<WheelEncoderDevice> d(new WheelEncoderDevice(core, slots));
+  std::unique_ptr<WheelEncoderDevice> d(new WheelEncoderDevice(core, first_slot));
   d->encoders_ = drivers::CanopenEncoders::create(bus, encoder_driver_config(cfg), error);
   if (!d->encoders_) return nullptr;
-  if (cfg.hardware.wheel_sensor >= 0) {
+  if (d->sensor_ >= 0) {
     d->wheels_ = drivers::WheelOdometry::create(wheel_driver_config(cfg), error);
     if (!d->wheels_) return nullptr;
   }
   // Samples of driver-fed sensors are in base_link.
-  d->sample_.sensor = static_cast<std::uint8_t>(cfg.hardware.wheel_sensor < 0 ? 0 : cfg.hardware.wheel_sensor);
+  d->sample_.sensor = static_cast<std::uint8_t>(d->sensor_ < 0 ? 0 : d->sensor_);
   d->sample_.kind = est::SensorKind::kTwist;
   d->sample_.frame = static_cast<std::int16_t>(core.frames().find(cfg.base_link_frame.view()));
   return d;
@@ -98,7 +107,7 @@ bool WheelEncoderDevice::start(TimeNs now, std::string* error) {
   return false;
 }
 
-void WheelEncoderDevice::before_drain(TimeNs now) noexcept {
+void WheelEncoderDevice::poll(TimeNs now) noexcept {
   encoders_->poll(now);
   drivers::EncoderSampleSet set;
   if (!wheels_ || !encoders_->take_sample_set(&set)) return;
@@ -119,14 +128,14 @@ void WheelEncoderDevice::before_drain(TimeNs now) noexcept {
   c(5, 5) = tw.var_vyaw;
   c(0, 5) = c(5, 0) = tw.cov_vx_vyaw;
   // The loop is this ring's only producer.
-  core_.input().push_from_driver(cfg_.hardware.wheel_sensor, s);
+  core_.input().push_from_driver(sensor_, s);
 }
 
 void WheelEncoderDevice::fill_snapshot(Snapshot& s) noexcept {
   const drivers::CanopenBusStats& b = encoders_->bus_stats();
-  DeviceStatus& bus = s.devices[slots_.can_bus];
-  set_device_values(bus, kCanBusKeys, kCanBusKeyCount,
-             {b.frames_received, b.syncs_sent, b.send_failures, b.malformed_frames, b.unexpected_cob_ids,
+  DeviceStatus& bus = s.devices[first_slot_];
+  set_device_values(bus, kCanBusKeys,
+                    {b.frames_received, b.syncs_sent, b.send_failures, b.malformed_frames, b.unexpected_cob_ids,
               b.error_frames, b.bus_off_events});
   set_device_message(bus.message, encoders_->last_error());
   if (b.bus_off) {
@@ -145,18 +154,18 @@ void WheelEncoderDevice::fill_snapshot(Snapshot& s) noexcept {
   for (int i = 0; i < encoders_->node_count(); ++i) {
     const drivers::EncoderReading& r = encoders_->reading(i);
     const drivers::EncoderNodeStats& n = encoders_->node_stats(i);
-    DeviceStatus& d = s.devices[slots_.first_node + i];
-    set_device_values(d, kEncoderNodeKeys, kEncoderNodeKeyCount,
-               {r.counts, n.tpdos, n.heartbeats, n.emcys, n.last_emcy_code, n.silent_events, n.stuck_events,
+    DeviceStatus& d = s.devices[first_slot_ + 1 + i];
+    set_device_values(d, kEncoderNodeKeys,
+                      {r.counts, n.tpdos, n.heartbeats, n.emcys, n.last_emcy_code, n.silent_events, n.stuck_events,
                 n.jump_events, n.recoveries, n.nmt_starts});
     d.level = encoder_level(r.health);
     d.state = drivers::to_string(r.health);
     set_device_message(d.message, encoders_->node_error(i));
   }
-  if (wheels_ && slots_.wheel_odometry >= 0) {
+  if (wheels_) {
     const drivers::WheelOdometryStats& w = wheels_->stats();
-    DeviceStatus& d = s.devices[slots_.wheel_odometry];
-    set_device_values(d, kWheelOdometryKeys, kWheelOdometryKeyCount, {w.outputs, w.no_side, w.reseeds});
+    DeviceStatus& d = s.devices[first_slot_ + 1 + encoders_->node_count()];
+    set_device_values(d, kWheelOdometryKeys, {w.outputs, w.no_side, w.reseeds});
     d.level = w.outputs == 0 ? DeviceLevel::kStale : DeviceLevel::kOk;
     d.state = w.outputs == 0 ? "waiting" : "running";
     // Its failures are its inputs': the nodes say what they were.

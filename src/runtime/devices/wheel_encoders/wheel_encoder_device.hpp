@@ -7,7 +7,7 @@
 
 #include "drivers/canopen/canopen_encoders.hpp"
 #include "drivers/wheel/wheel_odometry.hpp"
-#include "runtime/devices/device_layout.hpp"
+#include "runtime/devices/device.hpp"
 #include "runtime/fusion/fusion_core.hpp"
 
 namespace rtfuse {
@@ -17,26 +17,32 @@ namespace rtfuse {
 drivers::CanopenEncodersConfig encoder_driver_config(const RuntimeConfig& cfg);
 drivers::WheelOdometryConfig wheel_driver_config(const RuntimeConfig& cfg);
 
-class WheelEncoderDevice {
+// Counter keys of the CAN bus's, each node's and the odometry's slot.
+extern const char* const kCanBusKeys[7];
+extern const char* const kEncoderNodeKeys[10];
+extern const char* const kWheelOdometryKeys[3];
+
+class WheelEncoderDevice final : public Device {
  public:
-  // The configuration is the core's.
-  static std::unique_ptr<WheelEncoderDevice> create(hal::CanBus& bus, FusionCore& core, const DeviceSlots& slots,
+  // The configuration is the core's. Slots from first_slot: the bus, one per
+  // node, then the wheel odometry when a sensor fuses it.
+  static std::unique_ptr<WheelEncoderDevice> create(hal::CanBus& bus, FusionCore& core, int first_slot,
                                                     std::string* error);
   // NMT start to the encoder nodes.
-  bool start(TimeNs now, std::string* error);
-  // Loop thread.
-  void before_drain(TimeNs now) noexcept;
-  void fill_snapshot(Snapshot& s) noexcept;
+  bool start(TimeNs now, std::string* error) override;
+  void poll(TimeNs now) noexcept override;
+  void fill_snapshot(Snapshot& s) noexcept override;
 
   const drivers::CanopenEncoders& encoders() const { return *encoders_; }
   const drivers::WheelOdometry* wheel_odometry() const { return wheels_.get(); }
 
  private:
-  WheelEncoderDevice(FusionCore& core, const DeviceSlots& slots);
+  WheelEncoderDevice(FusionCore& core, int first_slot);
 
   const RuntimeConfig& cfg_;
   FusionCore& core_;
-  DeviceSlots slots_;
+  int first_slot_ = 0;
+  int sensor_ = -1;
   std::unique_ptr<drivers::CanopenEncoders> encoders_;
   std::unique_ptr<drivers::WheelOdometry> wheels_;
   drivers::WheelTwist last_twist_;

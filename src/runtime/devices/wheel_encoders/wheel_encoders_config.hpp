@@ -1,0 +1,11 @@
+#pragma once
+// [can], [[can.node]] and [wheel_odometry] from the TOML into cfg.hardware,
+// every problem with its file, line and key. Configuration time only.
+#include "runtime/config/config.hpp"
+
+namespace rtfuse::config {
+
+class Section;
+void read_wheel_encoders_config(const Section& root, RuntimeConfig& cfg);
+
+}  // namespace rtfuse::config
