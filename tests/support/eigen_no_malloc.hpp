@@ -5,16 +5,20 @@
 // a test compiles in every configuration: a bare call fails to compile where
 // the check is not armed, which is how a default build once broke.
 #include <Eigen/Core>
-#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::test {
 
 class EigenMallocForbidden {
  public:
   EigenMallocForbidden() {
-    test::EigenMallocForbidden eigen_no_malloc;
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+    Eigen::internal::set_is_malloc_allowed(false);
+#endif
   }
   ~EigenMallocForbidden() {
+#ifdef EIGEN_RUNTIME_NO_MALLOC
+    Eigen::internal::set_is_malloc_allowed(true);
+#endif
   }
   EigenMallocForbidden(const EigenMallocForbidden&) = delete;
   EigenMallocForbidden& operator=(const EigenMallocForbidden&) = delete;

@@ -149,7 +149,7 @@ TEST_F(GeometryFrameTree, FindInternAndName) {
 TEST_F(GeometryFrameTree, FindAndLookupDoNotAllocate) {
   const int imu = tree.find("imu_link");
   const int map = tree.find("map");
-  test::EigenMallocForbidden eigen_no_malloc;
+  rtfuse::test::EigenMallocForbidden eigen_no_malloc;
   const std::uint64_t before = rtfuse::test::allocation_count();
   double sum = 0;
   int found = 0;

@@ -25,7 +25,7 @@ TEST(GeometrySpscRingEigenPayload, PushPopWithoutAnyAllocation) {
   rtfuse::SpscRing<Sample> ring(5);
   Sample in;
   Sample out;
-  test::EigenMallocForbidden eigen_no_malloc;
+  rtfuse::test::EigenMallocForbidden eigen_no_malloc;
   const std::uint64_t before = rtfuse::test::allocation_count();
   bool ok = true;
   for (std::int64_t i = 0; i < 100; ++i) {

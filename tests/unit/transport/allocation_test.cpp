@@ -22,7 +22,7 @@ namespace {
 // Counts allocations made inside f, with Eigen's own check armed as well.
 template <class F>
 long allocations_in(F&& f) {
-  test::EigenMallocForbidden eigen_no_malloc;
+  rtfuse::test::EigenMallocForbidden eigen_no_malloc;
   long n = 0;
   {
     rtfuse::test::AllocScope scope;
