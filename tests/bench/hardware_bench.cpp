@@ -38,6 +38,7 @@
 #include "runtime/fusion_core.hpp"
 #include "runtime/hal_replay.hpp"
 #include "runtime/hardware.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "sim/simulated_drive.hpp"
 #include "sim/simulated_robot.hpp"
 #include "support/alloc_counter.hpp"
@@ -330,10 +331,10 @@ void BM_ReplayTenMinuteDrive(benchmark::State& state) {
     const Clock::time_point start = Clock::now();
     {
       rtfuse::transport::EventLogReader in;
-      rtfuse::transport::HalRecording rec;
+      rtfuse::HalRecording rec;
       std::string error;
       if (!in.open(drive.record_path, &error) ||
-          !rtfuse::transport::load_hal_recording(in, rtfuse::transport::HalRecordingOptions{}, &rec, &error)) {
+          !rtfuse::load_hal_recording(in, rtfuse::HalRecordingOptions{}, &rec, &error)) {
         state.SkipWithError(("loading the recording: " + error).c_str());
         break;
       }

@@ -31,14 +31,14 @@ class CompareSink final : public MessageSink {
  public:
   // Only the estimate channels are compared: other recorded channels (the
   // simulator's ground truth) are not the publisher's.
-  CompareSink(const transport::HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out)
+  CompareSink(const HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out)
       : diagnostics_(cfg.publish.diagnostics_channel.view()), out_(out) {
     const std::string estimate[] = {std::string(cfg.publish.odometry_channel.view()),
                                     std::string(cfg.publish.pose_channel.view()),
                                     std::string(cfg.publish.tf_channel.view()),
                                     std::string(cfg.publish.state_channel.view()),
                                     std::string(cfg.hardware.wheel_odometry.raw_channel.view())};
-    for (const transport::RecordedOutput& o : rec.outputs) {
+    for (const RecordedOutput& o : rec.outputs) {
       if (std::find(std::begin(estimate), std::end(estimate), o.channel) != std::end(estimate)) {
         recorded_[o.channel].push_back(&o);
       }
@@ -54,7 +54,7 @@ class CompareSink final : public MessageSink {
     auto it = recorded_.find(channel);
     std::size_t& next = next_[channel];
     if (it == recorded_.end() || next >= it->second.size()) return true;  // beyond the recording
-    const transport::RecordedOutput& r = *it->second[next++];
+    const RecordedOutput& r = *it->second[next++];
     ++compared;
     if (r.bytes.size() == static_cast<std::size_t>(size) && std::equal(r.bytes.begin(), r.bytes.end(), data)) {
       ++identical;
@@ -82,7 +82,7 @@ class CompareSink final : public MessageSink {
  private:
   std::string diagnostics_;
   transport::EventLogWriter* out_;
-  std::map<std::string, std::vector<const transport::RecordedOutput*>> recorded_;
+  std::map<std::string, std::vector<const RecordedOutput*>> recorded_;
   std::map<std::string, std::size_t> next_;
 };
 
@@ -91,7 +91,7 @@ class CompareSink final : public MessageSink {
 // not happen as recorded and publishes nothing.
 class ReplayOutput final : public OutputStage {
  public:
-  ReplayOutput(Publisher& publisher, MessageSink& sink, const transport::HalRecording& rec)
+  ReplayOutput(Publisher& publisher, MessageSink& sink, const HalRecording& rec)
       : publisher_(publisher), sink_(sink), rec_(rec) {}
   void expect(std::uint32_t recorded) { recorded_ = recorded; }
   std::uint32_t deliver(const Snapshot& snap, std::uint32_t, TimeNs now) noexcept override {
@@ -105,7 +105,7 @@ class ReplayOutput final : public OutputStage {
  private:
   Publisher& publisher_;
   MessageSink& sink_;
-  const transport::HalRecording& rec_;
+  const HalRecording& rec_;
   std::uint32_t recorded_ = 0;
 };
 
@@ -142,7 +142,7 @@ std::string check_recording_config(const transport::RecordingInfo& info, const s
          "); leave out --config to replay with the configuration stored in the recording";
 }
 
-HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const RuntimeConfig& given,
+HalReplayResult replay_hal_recording(const HalRecording& rec, const RuntimeConfig& given,
                                      transport::EventLogWriter* out,
                                      const std::function<void(const HalReplayProgress&)>& progress) {
   HalReplayResult result;
