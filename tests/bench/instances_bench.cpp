@@ -14,9 +14,9 @@
 #include "rtfuse/imu_t.hpp"
 #include "rtfuse/navsat_fix_t.hpp"
 #include "rtfuse/odometry_t.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/fusion_core.hpp"
-#include "runtime/publisher.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/fusion/fusion_core.hpp"
+#include "runtime/pipeline/publisher.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace {

@@ -19,7 +19,7 @@
 #include "bench/vo_pairs_run.hpp"
 #include "drivers/camera/stereo_rectification.hpp"
 #include "drivers/camera/stereo_rectifier.hpp"
-#include "runtime/visual_odometry.hpp"
+#include "runtime/devices/visual_odometry/visual_odometry.hpp"
 #include "sim/camera_world.hpp"
 #include "sim/stereo_renderer.hpp"
 #include "unit/drivers/zed_test_calibrations.hpp"

@@ -25,7 +25,7 @@
 #include <sstream>
 #include <string>
 
-#include "runtime/config_loader.hpp"
+#include "runtime/config/config_loader.hpp"
 #include "sim/sim_camera.hpp"
 #include "sim/simulated_drive.hpp"
 #include "sim/simulated_robot.hpp"

@@ -24,9 +24,9 @@
 #include "hal/linux/monotonic_clock.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
-#include "runtime/camera_calibration.hpp"
-#include "runtime/config_loader.hpp"
-#include "runtime/runtime.hpp"
+#include "runtime/devices/camera/camera_calibration.hpp"
+#include "runtime/config/config_loader.hpp"
+#include "runtime/live/runtime.hpp"
 #include "sim/simulated_robot.hpp"
 
 namespace {
