@@ -1,7 +1,6 @@
 #include "hal/replay/replay_stream.hpp"
 
 #include <algorithm>
-#include <cstdarg>
 #include <cstddef>
 #include <cstdio>
 #include <cstring>
@@ -37,9 +36,63 @@ bool same_frame(const CanFrame& a, const CanFrame& b) {
   return std::memcmp(a.data, b.data, std::min<std::size_t>(a.dlc, sizeof a.data)) == 0;
 }
 
-// Same kind of call on the same device with the same arguments.
-bool same_call(const BusEvent& rec, const BusEvent& call) {
-  if (rec.kind != call.kind || rec.device != call.device) return false;
+void add_frame(ReportText& t, const CanFrame& f) {
+  t.add(f.extended ? "id 0x%08X" : "id 0x%03X", static_cast<unsigned>(f.id));
+  if (f.extended) t.add(" ext");
+  if (f.rtr) t.add(" rtr");
+  if (f.error) t.add(" err");
+  t.add(" dlc %d", f.dlc);
+  const int n = std::min<int>(f.dlc, 8);
+  if (n > 0 && !f.rtr) {
+    t.add(" [");
+    for (int i = 0; i < n; ++i) t.add(i == 0 ? "%02X" : " %02X", f.data[i]);
+    t.add("]");
+  }
+}
+
+}  // namespace
+
+ReplayStream::ReplayStream(std::string name) : ReplayCursor(std::move(name)) {}
+
+void ReplayStream::reserve(std::size_t events) {
+  reserve_calls(events);
+  offsets_.reserve(events);
+  bytes_.reserve(events * (kHeadBytes + sizeof(CanFrame)));
+}
+
+void ReplayStream::append(const BusEvent& ev, std::int64_t log_event) {
+  if (!add_call(log_event)) return;
+  offsets_.push_back(bytes_.size());
+  const auto* raw = reinterpret_cast<const std::uint8_t*>(&ev);
+  bytes_.insert(bytes_.end(), raw, raw + kHeadBytes);
+  const auto* frames = reinterpret_cast<const std::uint8_t*>(ev.frames);
+  bytes_.insert(bytes_.end(), frames, frames + static_cast<std::size_t>(stored_frames(ev)) * sizeof(CanFrame));
+  bytes_.insert(bytes_.end(), ev.data, ev.data + stored_bytes(ev));
+}
+
+void ReplayStream::expand(std::size_t i, BusEvent* out) const noexcept {
+  *out = BusEvent{};
+  const std::uint8_t* p = bytes_.data() + offsets_[i];
+  std::memcpy(static_cast<void*>(out), p, kHeadBytes);
+  p += kHeadBytes;
+  const std::size_t frame_bytes = static_cast<std::size_t>(stored_frames(*out)) * sizeof(CanFrame);
+  std::memcpy(static_cast<void*>(out->frames), p, frame_bytes);
+  p += frame_bytes;
+  std::memcpy(out->data, p, static_cast<std::size_t>(stored_bytes(*out)));
+}
+
+BusEvent ReplayStream::event(std::size_t i) const noexcept {
+  BusEvent ev;
+  if (i < offsets_.size()) expand(i, &ev);
+  return ev;
+}
+
+const BusEvent& ReplayStream::recorded(std::size_t i) noexcept {
+  expand(i, &current_);
+  return current_;
+}
+
+bool ReplayStream::same_arguments(const BusEvent& rec, const BusEvent& call) noexcept {
   switch (rec.kind) {
     case BusEventKind::kCanSend: return same_frame(rec.frames[0], call.frames[0]);
     case BusEventKind::kCanReceive: return rec.length == call.length && rec.timeout_ns == call.timeout_ns;
@@ -61,104 +114,15 @@ bool same_call(const BusEvent& rec, const BusEvent& call) {
   return false;
 }
 
-using Text = ReportText;
-
-void add_frame(Text& t, const CanFrame& f) {
-  t.add(f.extended ? "id 0x%08X" : "id 0x%03X", static_cast<unsigned>(f.id));
-  if (f.extended) t.add(" ext");
-  if (f.rtr) t.add(" rtr");
-  if (f.error) t.add(" err");
-  t.add(" dlc %d", f.dlc);
-  const int n = std::min<int>(f.dlc, 8);
-  if (n > 0 && !f.rtr) {
-    t.add(" [");
-    for (int i = 0; i < n; ++i) t.add(i == 0 ? "%02X" : " %02X", f.data[i]);
-    t.add("]");
-  }
-}
-
-}  // namespace
-
-ReplayStream::ReplayStream(std::string name) : name_(std::move(name)) {}
-
-void ReplayStream::reserve(std::size_t events) {
-  heads_.reserve(events);
-  bytes_.reserve(events * (kHeadBytes + sizeof(CanFrame)));
-}
-
-void ReplayStream::append(const BusEvent& ev, std::int64_t log_event) {
-  heads_.push_back(Head{log_event, bytes_.size()});
-  const auto* raw = reinterpret_cast<const std::uint8_t*>(&ev);
-  bytes_.insert(bytes_.end(), raw, raw + kHeadBytes);
-  const auto* frames = reinterpret_cast<const std::uint8_t*>(ev.frames);
-  bytes_.insert(bytes_.end(), frames, frames + static_cast<std::size_t>(stored_frames(ev)) * sizeof(CanFrame));
-  bytes_.insert(bytes_.end(), ev.data, ev.data + stored_bytes(ev));
-}
-
-void ReplayStream::mark_hole(std::int64_t log_event, std::uint32_t lost) {
-  if (hole_lost_ > 0) return;  // only the first hole matters: the replay stops there
-  hole_event_ = log_event;
-  hole_lost_ = lost;
-}
-
-void ReplayStream::set_device_name(std::uint8_t device, std::string name) {
-  if (device_names_.size() <= device) device_names_.resize(static_cast<std::size_t>(device) + 1);
-  device_names_[device] = std::move(name);
-}
-
-void ReplayStream::expand(std::size_t i, BusEvent* out) const noexcept {
-  *out = BusEvent{};
-  const std::uint8_t* p = bytes_.data() + heads_[i].offset;
-  std::memcpy(static_cast<void*>(out), p, kHeadBytes);
-  p += kHeadBytes;
-  const std::size_t frame_bytes = static_cast<std::size_t>(stored_frames(*out)) * sizeof(CanFrame);
-  std::memcpy(static_cast<void*>(out->frames), p, frame_bytes);
-  p += frame_bytes;
-  std::memcpy(out->data, p, static_cast<std::size_t>(stored_bytes(*out)));
-}
-
-BusEvent ReplayStream::event(std::size_t i) const noexcept {
-  BusEvent ev;
-  if (i < heads_.size()) expand(i, &ev);
-  return ev;
-}
-
-const BusEvent* ReplayStream::take(const BusEvent& call) noexcept {
-  if (diverged()) return nullptr;
-  const std::size_t pos = position_.load(std::memory_order_relaxed);
-  if (pos >= heads_.size()) {
-    diverge(DivergenceKind::kEndOfStream, heads_.empty() ? -1 : heads_.back().log_event, nullptr, call);
-    return nullptr;
-  }
-  expand(pos, &current_);
-  if (!same_call(current_, call)) {
-    diverge(DivergenceKind::kMismatch, heads_[pos].log_event, &current_, call);
-    return nullptr;
-  }
-  position_.store(pos + 1, std::memory_order_release);
-  return &current_;
-}
-
-const char* ReplayStream::device_name(std::uint8_t device, char* scratch, std::size_t size) const noexcept {
-  if (device < device_names_.size() && !device_names_[device].empty()) return device_names_[device].c_str();
-  std::snprintf(scratch, size, "device %u", static_cast<unsigned>(device));
-  return scratch;
-}
-
-int ReplayStream::describe(char* buf, std::size_t size, const BusEvent& ev, bool attempted,
-                           bool with_device) const noexcept {
-  Text t(buf, size);
+void ReplayStream::describe_call(ReportText& t, const BusEvent& ev, bool attempted) const noexcept {
   if (attempted && ev.kind == BusEventKind::kCanSend) {
     t.add("sent");
-  } else if (attempted) {
-    t.add("called %s", to_string(ev.kind));
   } else {
-    t.add("%s", to_string(ev.kind));
+    t.add(attempted ? "called %s" : "%s", to_string(ev.kind));
   }
-  if (with_device) {
-    char scratch[24];
-    t.add(" on %s", device_name(ev.device, scratch, sizeof scratch));
-  }
+}
+
+void ReplayStream::describe_arguments(ReportText& t, const BusEvent& ev) const noexcept {
   switch (ev.kind) {
     case BusEventKind::kCanSend:
       t.add(" ");
@@ -190,35 +154,10 @@ int ReplayStream::describe(char* buf, std::size_t size, const BusEvent& ev, bool
     case BusEventKind::kSerialReopen:
     case BusEventKind::kNone: break;
   }
-  return t.length();
 }
 
-void ReplayStream::diverge(DivergenceKind kind, std::int64_t log_event, const BusEvent* recorded,
-                           const BusEvent& call) noexcept {
-  char attempted[256];
-  Text t(report_, sizeof report_);
-  if (kind == DivergenceKind::kMismatch && recorded != nullptr) {
-    const bool other_device = recorded->device != call.device;
-    char rec[256];
-    describe(rec, sizeof rec, *recorded, false, other_device);
-    describe(attempted, sizeof attempted, call, true, other_device);
-    t.add("event %lld: recorded %s, driver %s", static_cast<long long>(log_event), rec, attempted);
-  } else {
-    describe(attempted, sizeof attempted, call, true, true);
-    const auto replayed = static_cast<unsigned long long>(heads_.size());
-    if (hole_lost_ > 0) {
-      t.add("stream '%s' ends at event %lld, where the recorder lost %u events (its ring was full while "
-            "recording; %llu events replayed): driver %s",
-            name_.c_str(), static_cast<long long>(hole_event_), hole_lost_, replayed, attempted);
-    } else if (heads_.empty()) {
-      t.add("stream '%s' has no recorded events: driver %s", name_.c_str(), attempted);
-    } else {
-      t.add("stream '%s' ended after event %lld (%llu events replayed): driver %s", name_.c_str(),
-            static_cast<long long>(log_event), replayed, attempted);
-    }
-  }
-  report_event_ = log_event;
-  kind_.store(kind, std::memory_order_release);
+void ReplayStream::describe_hole(ReportText& t, unsigned long long replayed) const noexcept {
+  describe_lost_calls(t, replayed, "");
 }
 
 }  // namespace rtfuse::hal::replay

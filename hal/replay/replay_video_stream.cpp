@@ -1,38 +1,18 @@
 #include "hal/replay/replay_video_stream.hpp"
 
 #include <algorithm>
-#include <cstdarg>
-#include <cstdio>
 #include <cstring>
 #include <utility>
 
 #include "hal/replay/report_text.hpp"
 
 namespace rtfuse::hal::replay {
-namespace {
 
-// Same kind of call on the same device with the same arguments.
-bool same_call(const VideoEvent& rec, const VideoEvent& call) {
-  if (rec.kind != call.kind || rec.device != call.device) return false;
-  switch (rec.kind) {
-    case VideoCallKind::kDequeue: return rec.timeout_ns == call.timeout_ns;
-    case VideoCallKind::kRelease: return rec.index == call.index;
-    case VideoCallKind::kStart:
-    case VideoCallKind::kStop:
-    case VideoCallKind::kReopen:
-    case VideoCallKind::kNone: return true;
-  }
-  return false;
-}
-
-using Text = ReportText;
-
-}  // namespace
-
-ReplayVideoLog::ReplayVideoLog(std::string name) : name_(std::move(name)) {}
+ReplayVideoLog::ReplayVideoLog(std::string name) : ReplayCursor(std::move(name)) {}
 
 void ReplayVideoLog::append(const VideoEvent& ev, const std::uint8_t* data, std::int64_t log_event) {
-  Call c{ev, log_event, bytes_.size()};
+  if (!add_call(log_event)) return;
+  Call c{ev, bytes_.size()};
   if (ev.has_frame()) {
     // Zero-padded to the buffer's capacity: a driver may look past bytes_used
     // (a short frame) without reading outside the loaded recording.
@@ -45,9 +25,7 @@ void ReplayVideoLog::append(const VideoEvent& ev, const std::uint8_t* data, std:
 }
 
 void ReplayVideoLog::mark_hole(std::int64_t log_event, std::uint32_t lost, std::int64_t next_frames_before) {
-  if (hole_lost_ > 0) return;  // only the first hole matters: the replay stops there
-  hole_event_ = log_event;
-  hole_lost_ = lost;
+  if (!ReplayCursor::mark_hole(log_event, lost)) return;
   std::int64_t next_frame = 0;
   if (!calls_.empty()) {
     const VideoEvent& last = calls_.back().ev;
@@ -57,11 +35,6 @@ void ReplayVideoLog::mark_hole(std::int64_t log_event, std::uint32_t lost, std::
   hole_frames_ = std::max<std::int64_t>(0, next_frames_before - next_frame);
 }
 
-void ReplayVideoLog::set_device_name(std::uint8_t device, std::string name) {
-  if (device_names_.size() <= device) device_names_.resize(static_cast<std::size_t>(device) + 1);
-  device_names_[device] = std::move(name);
-}
-
 const std::uint8_t* ReplayVideoLog::data(std::size_t i) const noexcept {
   if (i >= calls_.size() || !calls_[i].ev.has_frame()) return nullptr;
   return bytes_.data() + calls_[i].offset;
@@ -69,69 +42,43 @@ const std::uint8_t* ReplayVideoLog::data(std::size_t i) const noexcept {
 
 const VideoEvent* ReplayVideoLog::take(const VideoEvent& call, const std::uint8_t** frame) noexcept {
   if (frame != nullptr) *frame = nullptr;
-  if (diverged()) return nullptr;
-  const std::size_t pos = position_.load(std::memory_order_relaxed);
-  if (pos >= calls_.size()) {
-    diverge(DivergenceKind::kEndOfStream, calls_.empty() ? -1 : calls_.back().log_event, nullptr, call);
-    return nullptr;
-  }
-  const Call& c = calls_[pos];
-  if (!same_call(c.ev, call)) {
-    diverge(DivergenceKind::kMismatch, c.log_event, &c.ev, call);
-    return nullptr;
-  }
-  if (frame != nullptr) *frame = data(pos);
-  position_.store(pos + 1, std::memory_order_release);
-  return &c.ev;
+  std::size_t taken = 0;
+  const VideoEvent* rec = take_next(call, &taken);
+  if (rec != nullptr && frame != nullptr) *frame = data(taken);
+  return rec;
 }
 
-int ReplayVideoLog::describe(char* buf, std::size_t size, const VideoEvent& ev, bool attempted,
-                             bool with_device) const noexcept {
-  Text t(buf, size);
-  t.add(attempted ? "called %s" : "%s", to_string(ev.kind));
-  if (with_device) {
-    if (ev.device < device_names_.size() && !device_names_[ev.device].empty()) {
-      t.add(" on %s", device_names_[ev.device].c_str());
-    } else {
-      t.add(" on device %u", static_cast<unsigned>(ev.device));
-    }
+bool ReplayVideoLog::same_arguments(const VideoEvent& rec, const VideoEvent& call) noexcept {
+  switch (rec.kind) {
+    case VideoCallKind::kDequeue: return rec.timeout_ns == call.timeout_ns;
+    case VideoCallKind::kRelease: return rec.index == call.index;
+    case VideoCallKind::kStart:
+    case VideoCallKind::kStop:
+    case VideoCallKind::kReopen:
+    case VideoCallKind::kNone: return true;
   }
+  return false;
+}
+
+void ReplayVideoLog::describe_call(ReportText& t, const VideoEvent& ev, bool attempted) const noexcept {
+  t.add(attempted ? "called %s" : "%s", to_string(ev.kind));
+}
+
+void ReplayVideoLog::describe_arguments(ReportText& t, const VideoEvent& ev) const noexcept {
   if (ev.kind == VideoCallKind::kDequeue) t.add(" timeout %lld ns", static_cast<long long>(ev.timeout_ns));
   if (ev.kind == VideoCallKind::kRelease) t.add(" index %d", ev.index);
-  return t.length();
 }
 
-void ReplayVideoLog::diverge(DivergenceKind kind, std::int64_t log_event, const VideoEvent* recorded,
-                             const VideoEvent& call) noexcept {
-  char attempted[160];
-  Text t(report_, sizeof report_);
-  if (kind == DivergenceKind::kMismatch && recorded != nullptr) {
-    const bool other_device = recorded->device != call.device;
-    char rec[160];
-    describe(rec, sizeof rec, *recorded, false, other_device);
-    describe(attempted, sizeof attempted, call, true, other_device);
-    t.add("event %lld: recorded %s, driver %s", static_cast<long long>(log_event), rec, attempted);
+void ReplayVideoLog::describe_hole(ReportText& t, unsigned long long replayed) const noexcept {
+  if (hole_frames_ > 0) {
+    // Frames are what a camera replay is for: name the first one missing.
+    t.add(": frame %lld of stream %s was not recorded: the recorder's ring was full (%lld frames, %u calls lost; "
+          "%llu calls replayed)",
+          static_cast<long long>(hole_first_frame_), name().c_str(), static_cast<long long>(hole_frames_),
+          hole_lost(), replayed);
   } else {
-    describe(attempted, sizeof attempted, call, true, true);
-    const auto replayed = static_cast<unsigned long long>(calls_.size());
-    if (hole_lost_ > 0 && hole_frames_ > 0) {
-      t.add("stream '%s' ends at event %lld: frame %lld of stream %s was not recorded: the recorder's ring "
-            "was full (%lld frames, %u calls lost; %llu calls replayed): driver %s",
-            name_.c_str(), static_cast<long long>(hole_event_), static_cast<long long>(hole_first_frame_),
-            name_.c_str(), static_cast<long long>(hole_frames_), hole_lost_, replayed, attempted);
-    } else if (hole_lost_ > 0) {
-      t.add("stream '%s' ends at event %lld, where the recorder lost %u calls (no frame among them; its ring "
-            "was full while recording; %llu calls replayed): driver %s",
-            name_.c_str(), static_cast<long long>(hole_event_), hole_lost_, replayed, attempted);
-    } else if (calls_.empty()) {
-      t.add("stream '%s' has no recorded video calls: driver %s", name_.c_str(), attempted);
-    } else {
-      t.add("stream '%s' ended after event %lld (%llu calls replayed): driver %s", name_.c_str(),
-            static_cast<long long>(log_event), replayed, attempted);
-    }
+    describe_lost_calls(t, replayed, "no frame among them; ");
   }
-  report_event_ = log_event;
-  kind_.store(kind, std::memory_order_release);
 }
 
 // ---------------------------------------------------------------- stream

@@ -21,6 +21,7 @@
 #include "runtime/devices/camera/camera_calibration.hpp"
 #include "runtime/devices/camera/camera_device.hpp"
 #include "runtime/config/config_loader.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
 #include "runtime/pipeline/recording_tap.hpp"
 #include "transport/hal_record_codec.hpp"
@@ -89,11 +90,11 @@ int write_pair(rtfuse::FramePool& pool, const rtfuse::drivers::StereoRectificati
 // through the same driver: what rtfused rectified while it recorded.
 int from_recording(const std::string& log_path, const std::string& out_path, int guide_px, int skip) {
   rtfuse::transport::EventLogReader in;
-  rtfuse::transport::HalRecording rec;
+  rtfuse::HalRecording rec;
   std::string error;
-  rtfuse::transport::HalRecordingOptions options;
+  rtfuse::HalRecordingOptions options;
   options.allow_truncated = true;  // a killed recorder's frames are still frames
-  if (!in.open(log_path, &error) || !rtfuse::transport::load_hal_recording(in, options, &rec, &error)) {
+  if (!in.open(log_path, &error) || !rtfuse::load_hal_recording(in, options, &rec, &error)) {
     std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
     return 1;
   }

@@ -16,6 +16,7 @@
 #include <CLI/CLI.hpp>
 
 #include "runtime/config/config_loader.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
 #include "runtime/replay/replay.hpp"
 #include "transport/hal_record_codec.hpp"
@@ -96,11 +97,11 @@ int replay_recording(const std::string& log_path, const std::string& config_path
     std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
     return 1;
   }
-  rtfuse::transport::HalRecording rec;
-  rtfuse::transport::HalRecordingOptions options;
+  rtfuse::HalRecording rec;
+  rtfuse::HalRecordingOptions options;
   options.allow_truncated = allow_truncated;
   options.max_frame_bytes = frame_memory_mib << 20;
-  if (!rtfuse::transport::load_hal_recording(in, options, &rec, &error)) {
+  if (!rtfuse::load_hal_recording(in, options, &rec, &error)) {
     std::fprintf(stderr, "rtfuse-replay: %s\n", error.c_str());
     return 1;
   }
@@ -176,7 +177,7 @@ int main(int argc, char** argv) {
   std::string config_path, log_path, out_path;
   bool quiet = false;
   bool allow_truncated = false;
-  std::uint64_t frame_memory_mib = rtfuse::transport::HalRecordingOptions{}.max_frame_bytes >> 20;
+  std::uint64_t frame_memory_mib = rtfuse::HalRecordingOptions{}.max_frame_bytes >> 20;
   app.add_option("-c,--config", config_path,
                  "TOML config (required for an ordinary log; a HAL recording carries its own)");
   app.add_option("-l,--log", log_path, "input LCM log")->required();

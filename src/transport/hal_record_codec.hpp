@@ -1,20 +1,15 @@
 #pragma once
-// HAL-level recordings (rtfused --record) as LCM logs, and loading them back
-// for rtfuse-replay.
-//
-// A recording is an lcm-logger file whose first event is a recording_info_t
-// on rtfuse/rec/info (format version, config, the device table: name, kind
-// and producing thread of every recorded bus). Then, in whatever order the
-// recorder drained its rings: one hal_can_t / hal_i2c_t / hal_gpio_t /
-// hal_clock_t / hal_serial_t per bus call, one hal_video_t per camera call
-// (with the frame bytes of a dequeue) on rtfuse/hal/<device name>, one loop_tick_t per
-// loop tick on rtfuse/rec/tick, and the published outputs on their own
-// channels. Events of one thread (stream) are in call order.
+// The records of a HAL recording's calls (the recording itself:
+// transport/recording_info.hpp; loading a whole one for a replay:
+// runtime/replay/hal_recording.hpp): one hal_can_t / hal_i2c_t / hal_gpio_t /
+// hal_clock_t / hal_serial_t per bus call and one hal_video_t per camera
+// call (with the frame bytes of a dequeue, transport/hal_video_codec.hpp) on
+// rtfuse/hal/<device name>, and one loop_tick_t per loop tick on
+// rtfuse/rec/tick.
 //
 // HalRecordCodec turns a hal::BusEvent into LCM bytes in a caller buffer and
 // back (a canonical event round-trips byte for byte). Its message objects
 // persist, so encoding allocates only until the largest message was seen once.
-#include <cstddef>
 #include <cstdint>
 #include <memory>
 #include <string>
@@ -23,103 +18,16 @@
 
 #include "core/time.hpp"
 #include "hal/bus_event.hpp"
-#include "hal/replay/replay_stream.hpp"
-#include "hal/replay/replay_video_stream.hpp"
 #include "hal/video_event.hpp"
-#include "transport/event_log.hpp"
+#include "transport/hal_video_codec.hpp"
+#include "transport/recording_info.hpp"
 
 namespace rtfuse::transport {
 
-// Bump when a rtfuse/hal/* or rtfuse/rec/* record changes meaning or layout.
-// 3: a recording ends with its rtfuse/rec/end record.
-constexpr std::int32_t kHalRecordFormatVersion = 3;
-
-constexpr std::string_view kRecordingInfoChannel = "rtfuse/rec/info";
-constexpr std::string_view kLoopTickChannel = "rtfuse/rec/tick";
-constexpr std::string_view kRecordedFileChannel = "rtfuse/rec/file";
-constexpr std::string_view kRecordingEndChannel = "rtfuse/rec/end";
-constexpr std::string_view kRecordChannelPrefix = "rtfuse/rec/";
-constexpr std::string_view kHalChannelPrefix = "rtfuse/hal/";
-
-constexpr int kMaxRecordedDevices = 64;
-constexpr int kMaxRecordedStreams = 16;
-constexpr std::size_t kMaxDeviceNameLength = 48;
 constexpr int kMaxTickSensors = 64;
 // Largest encoded bus event (a receive of 16 frames on a 48-character device
 // name is under 500 bytes).
 constexpr int kMaxHalRecordSize = 1024;
-// A hal_video_t is its frame bytes plus at most this much (fields and a
-// 48-character device name): size the encode buffer slot_bytes + this.
-constexpr int kVideoRecordOverhead = 256;
-
-// Stored as recording_info_t.device_kinds (DEVICE_*): append only.
-// kVideo records hal_video_t (hal::VideoEvent), not BusEvents, through its
-// own ring, so a video device's stream holds no other device (the order of
-// two rings is not kept in the log).
-enum class DeviceKind : std::uint8_t { kCan, kI2c, kGpioEdge, kGpioOutput, kClock, kVideo, kSerial };
-constexpr DeviceKind kLastDeviceKind = DeviceKind::kSerial;
-const char* to_string(DeviceKind k) noexcept;
-// The bus call kinds a device of this kind records (none for kVideo).
-bool records(DeviceKind device, hal::BusEventKind call) noexcept;
-
-struct RecordedDevice {
-  std::string name;  // "can0", "i2c-1", "imu-drdy", "imu-clock"; channel rtfuse/hal/<name>
-  DeviceKind kind = DeviceKind::kCan;
-  int stream = 0;  // index into RecordingInfo::streams of the thread that uses it
-};
-
-// A file the configuration refers to, carried by the recording
-// (recording_file_t): the camera's calibration.
-struct RecordedFile {
-  std::string key;   // the config key naming it: "camera.calibration"
-  std::string path;  // where it was read from
-  std::string text;  // its bytes
-};
-constexpr int kMaxRecordedFiles = 8;
-constexpr std::size_t kMaxRecordedFileKeyLength = 64;
-constexpr std::size_t kMaxRecordedFilePathLength = 4096;
-constexpr std::size_t kMaxRecordedFileBytes = 1024 * 1024;
-
-struct RecordingInfo {
-  std::int32_t format_version = kHalRecordFormatVersion;
-  TimeNs start_ns = 0;
-  std::string rtfuse_version;
-  std::string config_path;
-  std::string config_text;
-  std::int64_t config_hash = 0;  // config_text_hash(config_text)
-  std::vector<std::string> streams;  // producing threads: "loop", "imu"
-  std::vector<RecordedDevice> devices;  // index = hal::BusEvent::device
-  // Written as rtfuse/rec/file events after the recording_info_t.
-  std::vector<RecordedFile> files;
-};
-
-// FNV-1a (64-bit) of the config text.
-std::int64_t config_text_hash(std::string_view text) noexcept;
-
-// Device names non-empty, at most kMaxDeviceNameLength, unique, without '/'
-// or spaces; stream indices valid; counts within the limits above; a video
-// device's stream holds only video devices; files within their limits, keys
-// unique.
-bool validate(const RecordingInfo& info, std::string* error);
-
-std::vector<std::uint8_t> encode_recording_info(const RecordingInfo& info);
-// Fails on bytes that are not a recording_info_t, on another format version
-// (named, with the fix), and on an invalid device table.
-bool decode_recording_info(const void* data, int size, RecordingInfo* out, std::string* error);
-
-std::vector<std::uint8_t> encode_recorded_file(const RecordedFile& file);
-// Fails on bytes that are not a recording_file_t or exceed the limits above.
-bool decode_recorded_file(const void* data, int size, RecordedFile* out, std::string* error);
-
-// The recording_end_t a recorder writes last when it closes cleanly.
-struct RecordingEnd {
-  TimeNs end_ns = 0;             // the last event's time before it
-  std::int64_t events = 0;       // events in the log before it
-  std::int64_t lost_events = 0;  // events the recorder could not write
-};
-std::vector<std::uint8_t> encode_recording_end(const RecordingEnd& end);
-// Fails on bytes that are not a recording_end_t or hold impossible counts.
-bool decode_recording_end(const void* data, int size, RecordingEnd* out, std::string* error);
 
 struct LoopTick {
   TimeNs time_ns = 0;
@@ -153,9 +61,10 @@ class HalRecordCodec {
                   int capacity);
   static bool decode_tick(const void* data, int size, LoopTick* out, std::string* error);
 
-  // hal_video_t of a video device: ev and, when ev.has_frame(), its
-  // ev.data_size bytes at data. Bytes written or -1 (unknown device, not a
-  // video device, capacity too small: data_size + kVideoRecordOverhead fits).
+  // hal_video_t of a video device (HalVideoCodec): ev and, when
+  // ev.has_frame(), its ev.data_size bytes at data. Bytes written or -1
+  // (unknown device, not a video device, capacity too small: data_size +
+  // kVideoRecordOverhead fits).
   int encode_video(const hal::VideoEvent& ev, const std::uint8_t* data, std::uint8_t* buf, int capacity);
   // The hal_video_t on `channel` into *out; *frame points at its
   // out->data_size frame bytes (inside this codec, valid until the next
@@ -171,58 +80,7 @@ class HalRecordCodec {
   std::vector<RecordedDevice> devices_;
   std::vector<std::string> channels_;
   std::unique_ptr<Messages> msgs_;
+  HalVideoCodec video_;
 };
-
-// --- loading a whole recording (rtfuse-replay; allocates freely) -----------
-
-struct RecordedOutput {
-  std::string channel;
-  std::int64_t utime = 0;         // the log event's timestamp
-  std::int64_t event_number = 0;  // in the log
-  std::vector<std::uint8_t> bytes;
-};
-
-struct HalRecording {
-  RecordingInfo info;
-  // One per info.streams entry, in that order, with every device's name set.
-  std::vector<std::unique_ptr<hal::replay::ReplayStream>> streams;
-  // One per info.streams entry too: the recorded camera calls of that stream
-  // (empty for a stream without a video device), frames in memory.
-  std::vector<std::unique_ptr<hal::replay::ReplayVideoLog>> videos;
-  std::vector<LoopTick> ticks;
-  std::vector<RecordedOutput> outputs;
-  std::int64_t events = 0;         // log events loaded
-  // The log ends mid-event or without its end record: the recorder was
-  // killed or lost power (loaded with allow_truncated).
-  bool truncated = false;
-  std::int64_t lost_events = 0;    // bus events and video calls the recorder had no room for
-  std::int64_t lost_frames = 0;    // camera frames among them
-  std::int64_t missing_ticks = 0;  // gaps in the tick sequence
-  std::vector<std::string> warnings;  // one line each: truncation, holes, missing ticks
-};
-
-struct HalRecordingOptions {
-  // Keep the complete events of a log that ends mid-event or without its
-  // end record (a killed recorder, a power loss).
-  bool allow_truncated = false;
-  // Camera frames are held in memory for the replay, each padded to its
-  // buffer's capacity as the driver saw it. A recording whose frames need
-  // more is refused with the figure (rtfuse-replay --frame-memory) rather
-  // than left to the OOM killer: a corrupt buffer length in a few bytes of
-  // log could otherwise ask for gigabytes.
-  std::uint64_t max_frame_bytes = std::uint64_t{4} << 30;
-};
-
-// Reads the whole log from an open reader. False with one error naming the
-// file, the event number and channel, and the likely fix when: the first
-// event is not a recording_info_t (not a recording), its format version is
-// not kHalRecordFormatVersion, the log is truncated or lacks its end record
-// (unless allowed), an event cannot be decoded, an event follows the end
-// record, the end record's count differs from the events read, or the log is
-// corrupt.
-// A stream whose recorder lost events (ring overflow) is loaded up to the
-// hole; its end-of-stream report says so.
-bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& options, HalRecording* out,
-                        std::string* error);
 
 }  // namespace rtfuse::transport

@@ -39,6 +39,7 @@
 #include "runtime/replay/hal_replay.hpp"
 #include "runtime/devices/hardware.hpp"
 #include "runtime/devices/imu/imu_device.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "sim/simulated_drive.hpp"
 #include "sim/sim_imu.hpp"
 #include "sim/simulated_robot.hpp"
@@ -334,10 +335,10 @@ void BM_ReplayTenMinuteDrive(benchmark::State& state) {
     const Clock::time_point start = Clock::now();
     {
       rtfuse::transport::EventLogReader in;
-      rtfuse::transport::HalRecording rec;
+      rtfuse::HalRecording rec;
       std::string error;
       if (!in.open(drive.record_path, &error) ||
-          !rtfuse::transport::load_hal_recording(in, rtfuse::transport::HalRecordingOptions{}, &rec, &error)) {
+          !rtfuse::load_hal_recording(in, rtfuse::HalRecordingOptions{}, &rec, &error)) {
         state.SkipWithError(("loading the recording: " + error).c_str());
         break;
       }

@@ -9,10 +9,13 @@
 
 #include "fuzz_check.hpp"
 #include "memory_file.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "transport/event_log.hpp"
-#include "transport/hal_record_codec.hpp"
 
-using namespace rtfuse::transport;
+using rtfuse::HalRecording;
+using rtfuse::HalRecordingOptions;
+using rtfuse::load_hal_recording;
+using rtfuse::transport::EventLogReader;
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   if (size < 1) return 0;

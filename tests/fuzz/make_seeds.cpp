@@ -21,6 +21,7 @@
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/twist_with_covariance_stamped_t.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
 

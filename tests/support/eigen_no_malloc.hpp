@@ -5,7 +5,6 @@
 // a test compiles in every configuration: a bare call fails to compile where
 // the check is not armed, which is how a default build once broke.
 #include <Eigen/Core>
-#include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::test {
 

@@ -20,7 +20,7 @@
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/device_buses.hpp"
 #include "runtime/fusion/device_status.hpp"
-#include "transport/hal_record_codec.hpp"
+#include "transport/recording_info.hpp"
 
 namespace rtfuse {
 

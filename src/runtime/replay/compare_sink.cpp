@@ -5,14 +5,14 @@
 
 namespace rtfuse {
 
-CompareSink::CompareSink(const transport::HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out)
+CompareSink::CompareSink(const HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out)
     : diagnostics_(cfg.publish.diagnostics_channel.view()), out_(out) {
   const std::string estimate[] = {std::string(cfg.publish.odometry_channel.view()),
                                   std::string(cfg.publish.pose_channel.view()),
                                   std::string(cfg.publish.tf_channel.view()),
                                   std::string(cfg.publish.state_channel.view()),
                                   std::string(cfg.hardware.wheel_odometry.raw_channel.view())};
-  for (const transport::RecordedOutput& o : rec.outputs) {
+  for (const RecordedOutput& o : rec.outputs) {
     if (std::find(std::begin(estimate), std::end(estimate), o.channel) != std::end(estimate)) {
       recorded_[o.channel].push_back(&o);
     }
@@ -28,7 +28,7 @@ bool CompareSink::publish(const char* channel, const std::uint8_t* data, int siz
   auto it = recorded_.find(channel);
   std::size_t& next = next_[channel];
   if (it == recorded_.end() || next >= it->second.size()) return true;  // beyond the recording
-  const transport::RecordedOutput& r = *it->second[next++];
+  const RecordedOutput& r = *it->second[next++];
   ++compared;
   if (r.bytes.size() == static_cast<std::size_t>(size) && std::equal(r.bytes.begin(), r.bytes.end(), data)) {
     ++identical;

@@ -8,8 +8,8 @@
 #include <vector>
 
 #include "runtime/config/config.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "transport/event_log.hpp"
-#include "transport/hal_record_codec.hpp"
 #include "transport/message_sink.hpp"
 
 namespace rtfuse {
@@ -19,7 +19,7 @@ class CompareSink final : public transport::MessageSink {
   // Only the estimate channels are compared: other recorded channels (the
   // simulator's ground truth) are not the publisher's, and diagnostics hold
   // the live machine's timings.
-  CompareSink(const transport::HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out);
+  CompareSink(const HalRecording& rec, const RuntimeConfig& cfg, transport::EventLogWriter* out);
 
   bool publish(const char* channel, const std::uint8_t* data, int size, TimeNs now) override;
   // Recorded estimate messages the replay has not published (yet).
@@ -32,7 +32,7 @@ class CompareSink final : public transport::MessageSink {
  private:
   std::string diagnostics_;
   transport::EventLogWriter* out_;
-  std::map<std::string, std::vector<const transport::RecordedOutput*>> recorded_;
+  std::map<std::string, std::vector<const RecordedOutput*>> recorded_;
   std::map<std::string, std::size_t> next_;
 };
 

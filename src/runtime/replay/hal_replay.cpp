@@ -22,7 +22,7 @@ std::string hex64(std::int64_t v) {
 // not happen as recorded and publishes nothing.
 class ReplayOutput final : public OutputStage {
  public:
-  ReplayOutput(Publisher& publisher, MessageSink& sink, const transport::HalRecording& rec)
+  ReplayOutput(Publisher& publisher, MessageSink& sink, const HalRecording& rec)
       : publisher_(publisher), sink_(sink), rec_(rec) {}
   void expect(std::uint32_t recorded) { recorded_ = recorded; }
   std::uint32_t deliver(const Snapshot& snap, std::uint32_t, TimeNs now) noexcept override {
@@ -36,14 +36,14 @@ class ReplayOutput final : public OutputStage {
  private:
   Publisher& publisher_;
   MessageSink& sink_;
-  const transport::HalRecording& rec_;
+  const HalRecording& rec_;
   std::uint32_t recorded_ = 0;
 };
 
 // The configuration as the live run had it: the files its devices read
 // (the camera's calibration) from the recording, not from this machine,
 // where they may differ or be missing.
-RuntimeConfig recorded_config(const transport::HalRecording& rec, const RuntimeConfig& given) {
+RuntimeConfig recorded_config(const HalRecording& rec, const RuntimeConfig& given) {
   RuntimeConfig cfg = given;
   for (const transport::RecordedFile& f : rec.info.files) {
     for (int i = 0; i < device_type_count(); ++i) {
@@ -55,7 +55,7 @@ RuntimeConfig recorded_config(const transport::HalRecording& rec, const RuntimeC
 
 // A HAL recording replays driver inputs only: a sensor that took LCM
 // messages live would be starved here, and the outputs could not match.
-std::string lcm_inputs_used(const transport::HalRecording& rec, const RuntimeConfig& cfg) {
+std::string lcm_inputs_used(const HalRecording& rec, const RuntimeConfig& cfg) {
   for (int i = 0; i < cfg.num_sensors; ++i) {
     if (cfg.sensors[static_cast<std::size_t>(i)].source != kLcmSource) continue;
     for (const transport::LoopTick& t : rec.ticks) {
@@ -71,7 +71,7 @@ std::string lcm_inputs_used(const transport::HalRecording& rec, const RuntimeCon
 // One recording through one tick pipeline, tick by tick.
 class HalReplay {
  public:
-  HalReplay(const transport::HalRecording& rec, HalReplayResult& result) : rec_(rec), result_(result) {}
+  HalReplay(const HalRecording& rec, HalReplayResult& result) : rec_(rec), result_(result) {}
 
   // Binds the recorded buses, makes the pipeline and starts its devices at
   // the recording's start time. False with result_.error (or a divergence).
@@ -90,7 +90,7 @@ class HalReplay {
   bool stopped_by_a_stream();
   bool stopped_by_video(const hal::replay::ReplayVideoLog* v, const char* device);
 
-  const transport::HalRecording& rec_;
+  const HalRecording& rec_;
   HalReplayResult& result_;
   std::unique_ptr<ReplayBuses> buses_;
   std::unique_ptr<CompareSink> sink_;
@@ -252,7 +252,7 @@ std::string check_recording_config(const transport::RecordingInfo& info, const s
          "); leave out --config to replay with the configuration stored in the recording";
 }
 
-HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const RuntimeConfig& cfg,
+HalReplayResult replay_hal_recording(const HalRecording& rec, const RuntimeConfig& cfg,
                                      transport::EventLogWriter* out,
                                      const std::function<void(const HalReplayProgress&)>& progress) {
   HalReplayResult result;

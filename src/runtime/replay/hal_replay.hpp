@@ -16,6 +16,7 @@
 
 #include "runtime/config/config.hpp"
 #include "runtime/fusion/snapshot.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
 
@@ -44,7 +45,7 @@ struct HalReplayProgress {
 };
 
 // cfg must be the recording's configuration (check_recording_config).
-HalReplayResult replay_hal_recording(const transport::HalRecording& rec, const RuntimeConfig& cfg,
+HalReplayResult replay_hal_recording(const HalRecording& rec, const RuntimeConfig& cfg,
                                      transport::EventLogWriter* out,
                                      const std::function<void(const HalReplayProgress&)>& progress);
 

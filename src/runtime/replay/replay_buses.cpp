@@ -43,7 +43,7 @@ std::string bus_list(std::uint32_t kinds) {
 
 }  // namespace
 
-std::unique_ptr<ReplayBuses> ReplayBuses::bind(const transport::HalRecording& rec, const RuntimeConfig& cfg,
+std::unique_ptr<ReplayBuses> ReplayBuses::bind(const HalRecording& rec, const RuntimeConfig& cfg,
                                                std::string* error) {
   std::unique_ptr<ReplayBuses> r(new ReplayBuses());
   for (int i = 0; i < device_type_count(); ++i) {

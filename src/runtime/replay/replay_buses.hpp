@@ -15,7 +15,7 @@
 #include "hal/replay/replay_video_stream.hpp"
 #include "runtime/config/config.hpp"
 #include "runtime/devices/hal_buses.hpp"
-#include "transport/hal_record_codec.hpp"
+#include "runtime/replay/hal_recording.hpp"
 
 namespace rtfuse {
 
@@ -44,7 +44,7 @@ struct ReplayedDevice {
 class ReplayBuses {
  public:
   // Null with *error naming the section and what the recording lacks.
-  static std::unique_ptr<ReplayBuses> bind(const transport::HalRecording& rec, const RuntimeConfig& cfg,
+  static std::unique_ptr<ReplayBuses> bind(const HalRecording& rec, const RuntimeConfig& cfg,
                                            std::string* error);
   const HalBuses& buses() const { return buses_; }
   // By registered device name (a thread device's, Hardware::thread_device_name).

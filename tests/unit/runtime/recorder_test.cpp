@@ -15,6 +15,7 @@
 #include "hal/replay/replay_can_bus.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "hal/recording_can_bus.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::runtime {
@@ -24,7 +25,6 @@ using hal::BusEvent;
 using hal::BusEventKind;
 using hal::HalStatus;
 using transport::DeviceKind;
-using transport::HalRecording;
 using transport::RecordingInfo;
 
 // A log path of this test, removed afterwards.
@@ -46,9 +46,9 @@ RecordingInfo make_info() {
 bool load(const std::string& path, HalRecording* rec, std::string* err, bool allow_truncated = false) {
   transport::EventLogReader reader;
   if (!reader.open(path, err)) return false;
-  transport::HalRecordingOptions opts;
+  HalRecordingOptions opts;
   opts.allow_truncated = allow_truncated;
-  return transport::load_hal_recording(reader, opts, rec, err);
+  return load_hal_recording(reader, opts, rec, err);
 }
 
 BusEvent clock_now(TimeNs t) {

@@ -14,6 +14,7 @@
 #include "hal/recording_video_stream.hpp"
 #include "hal/replay/replay_video_stream.hpp"
 #include "runtime/pipeline/recorder.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "support/temp_file.hpp"
 
 namespace rtfuse::runtime {
@@ -22,7 +23,6 @@ namespace {
 using hal::HalStatus;
 using hal::VideoFrame;
 using transport::DeviceKind;
-using transport::HalRecording;
 using transport::RecordingInfo;
 
 constexpr TimeNs kMs = 1'000'000;
@@ -55,7 +55,7 @@ RecordingInfo make_info() {
 bool load(const std::string& path, HalRecording* rec, std::string* err) {
   transport::EventLogReader reader;
   if (!reader.open(path, err)) return false;
-  return transport::load_hal_recording(reader, transport::HalRecordingOptions{}, rec, err);
+  return load_hal_recording(reader, HalRecordingOptions{}, rec, err);
 }
 
 struct LiveFrame {

@@ -19,6 +19,7 @@
 
 #include "runtime/config/config_loader.hpp"
 #include "runtime/pipeline/recording_tap.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "sim/simulated_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
@@ -93,7 +94,7 @@ class HalReplay : public testing::Test {
     transport::EventLogReader reader;
     std::string err;
     ASSERT_TRUE(reader.open(*record_path_, &err)) << err;
-    ASSERT_TRUE(transport::load_hal_recording(reader, {}, &rec_, &err)) << err;
+    ASSERT_TRUE(load_hal_recording(reader, {}, &rec_, &err)) << err;
     ASSERT_TRUE(rec_.warnings.empty()) << rec_.warnings.front();
   }
 
@@ -140,7 +141,7 @@ class HalReplay : public testing::Test {
   static std::string* config_text_;
   static RuntimeConfig* config_;
   static sim::DriveResult* drive_;
-  transport::HalRecording rec_;
+  HalRecording rec_;
 };
 
 std::string* HalReplay::scenario_path_ = nullptr;

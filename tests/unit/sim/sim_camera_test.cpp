@@ -20,6 +20,7 @@
 #include "sim/simulated_robot.hpp"
 #include "support/alloc_counter.hpp"
 #include "runtime/devices/device_layout.hpp"
+#include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
 #include "sim/simulated_drive.hpp"
 #include "transport/event_log.hpp"
@@ -113,8 +114,8 @@ TEST(SimCamera, RecordedFramesReplayThroughTheDriver) {
   transport::EventLogReader reader;
   std::string err;
   ASSERT_TRUE(reader.open(path, &err)) << err;
-  transport::HalRecording rec;
-  ASSERT_TRUE(transport::load_hal_recording(reader, {}, &rec, &err)) << err;
+  HalRecording rec;
+  ASSERT_TRUE(load_hal_recording(reader, {}, &rec, &err)) << err;
   EXPECT_EQ(rec.lost_frames, 0);
   // The calibration travels in the recording: the replay uses it even where
   // the file the config names does not exist.
