@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <atomic>
+#include <chrono>
 #include <thread>
 
 namespace rtfuse {
@@ -84,9 +85,11 @@ TEST(FrameMailbox, ASlowConsumerNeverStarvesTheProducer) {
     }
   });
   // Until the consumer has worked on a good many pairs while the producer
-  // ran flat out (bounded, should the consumer's thread never be scheduled).
+  // ran flat out; on a loaded machine its thread may get little time, so
+  // the bound is a time, not a count.
+  const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(30);
   std::int64_t produced = 0;
-  for (; produced < 2'000'000 && (produced < 20000 || taken.load() < 200); ++produced) {
+  for (; produced < 20000 || (taken.load() < 200 && std::chrono::steady_clock::now() < give_up); ++produced) {
     FramePool::WriteSlot w = pool.acquire();
     ASSERT_TRUE(w.valid()) << "the producer found no free slot at frame " << produced;
     w.left[0] = 1;
