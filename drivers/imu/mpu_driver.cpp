@@ -33,17 +33,17 @@ bool all_bytes(const std::uint8_t* b, int n, std::uint8_t v) noexcept {
 
 }  // namespace
 
-const char* to_string(ReadStatus s) noexcept {
+const char* to_string(MpuReadStatus s) noexcept {
   switch (s) {
-    case ReadStatus::kOk: return "ok";
-    case ReadStatus::kSaturated: return "saturated";
-    case ReadStatus::kNack: return "nack";
-    case ReadStatus::kBusError: return "bus error";
-    case ReadStatus::kTimeout: return "timeout";
-    case ReadStatus::kIoError: return "i/o error";
-    case ReadStatus::kFrozen: return "frozen";
-    case ReadStatus::kImpossible: return "impossible values";
-    case ReadStatus::kNotInitialised: return "not initialised";
+    case MpuReadStatus::kOk: return "ok";
+    case MpuReadStatus::kSaturated: return "saturated";
+    case MpuReadStatus::kNack: return "nack";
+    case MpuReadStatus::kBusError: return "bus error";
+    case MpuReadStatus::kTimeout: return "timeout";
+    case MpuReadStatus::kIoError: return "i/o error";
+    case MpuReadStatus::kFrozen: return "frozen";
+    case MpuReadStatus::kImpossible: return "impossible values";
+    case MpuReadStatus::kNotInitialised: return "not initialised";
   }
   return "?";
 }
@@ -223,7 +223,7 @@ bool MpuDriver::init(TimeNs now) noexcept {
   return true;
 }
 
-ReadStatus MpuDriver::fail(ReadStatus s) noexcept {
+MpuReadStatus MpuDriver::fail(MpuReadStatus s) noexcept {
   ++stats_.consecutive_failures;
   if (!needs_reinit_ && stats_.consecutive_failures >= config_.failures_before_reinit) {
     needs_reinit_ = true;
@@ -232,21 +232,21 @@ ReadStatus MpuDriver::fail(ReadStatus s) noexcept {
   return s;
 }
 
-ReadStatus MpuDriver::bus_failure(hal::HalStatus s) noexcept {
+MpuReadStatus MpuDriver::bus_failure(hal::HalStatus s) noexcept {
   error_.set("mpu at 0x%02x: data read failed (%s: %s)", config_.address, hal::to_string(s), bus_.last_error());
   switch (s) {
-    case hal::HalStatus::kNack: ++stats_.nacks; return fail(ReadStatus::kNack);
-    case hal::HalStatus::kBusError: ++stats_.bus_errors; return fail(ReadStatus::kBusError);
-    case hal::HalStatus::kTimeout: ++stats_.timeouts; return fail(ReadStatus::kTimeout);
-    default: ++stats_.io_errors; return fail(ReadStatus::kIoError);
+    case hal::HalStatus::kNack: ++stats_.nacks; return fail(MpuReadStatus::kNack);
+    case hal::HalStatus::kBusError: ++stats_.bus_errors; return fail(MpuReadStatus::kBusError);
+    case hal::HalStatus::kTimeout: ++stats_.timeouts; return fail(MpuReadStatus::kTimeout);
+    default: ++stats_.io_errors; return fail(MpuReadStatus::kIoError);
   }
 }
 
-ReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
+MpuReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
   ++stats_.reads;
   if (!initialised_) {
     error_.set("mpu at 0x%02x: read before a successful init()", config_.address);
-    return ReadStatus::kNotInitialised;
+    return MpuReadStatus::kNotInitialised;
   }
   std::uint8_t b[mpu_reg::kDataBytes];
   const hal::HalStatus s = bus_.read_registers(config_.address, mpu_reg::kAccelXoutH, b, mpu_reg::kDataBytes);
@@ -255,7 +255,7 @@ ReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
   if (all_bytes(b, mpu_reg::kDataBytes, 0x00) || all_bytes(b, mpu_reg::kDataBytes, 0xFF)) {
     ++stats_.impossible;
     error_.set("mpu at 0x%02x: data bytes all 0x%02x: bus garbage (chip asleep or lost power?)", config_.address, b[0]);
-    return fail(ReadStatus::kImpossible);
+    return fail(MpuReadStatus::kImpossible);
   }
 
   if (std::memcmp(b, last_bytes_, sizeof b) == 0) {
@@ -268,7 +268,7 @@ ReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
     ++stats_.frozen;
     error_.set("mpu at 0x%02x: the same 14 data bytes %d reads in a row: signal chain frozen", config_.address,
                same_count_);
-    return fail(ReadStatus::kFrozen);
+    return fail(MpuReadStatus::kFrozen);
   }
 
   std::int16_t raw[7];
@@ -278,7 +278,7 @@ ReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
     ++stats_.impossible;
     error_.set("mpu at 0x%02x: temperature %d C (raw %d) outside -40..85 C: corrupt read or wrong model",
                config_.address, static_cast<int>(temp), raw[3]);
-    return fail(ReadStatus::kImpossible);
+    return fail(MpuReadStatus::kImpossible);
   }
 
   const bool accel_sat = at_full_scale(raw[0]) || at_full_scale(raw[1]) || at_full_scale(raw[2]);
@@ -287,7 +287,7 @@ ReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
   needs_reinit_ = false;
   if (accel_sat || gyro_sat) {
     ++stats_.saturated;
-    if (config_.saturation == MpuSaturation::kReject) return ReadStatus::kSaturated;
+    if (config_.saturation == MpuSaturation::kReject) return MpuReadStatus::kSaturated;
   }
 
   const Eigen::Vector3d accel_imu(raw[0], raw[1], raw[2]);
@@ -300,7 +300,7 @@ ReadStatus MpuDriver::read(TimeNs stamp, ImuReading* out) noexcept {
   out->gyro_saturated = gyro_sat;
   std::memcpy(out->raw, raw, sizeof raw);
   ++stats_.good_reads;
-  return ReadStatus::kOk;
+  return MpuReadStatus::kOk;
 }
 
 }  // namespace rtfuse::drivers

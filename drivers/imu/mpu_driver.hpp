@@ -32,7 +32,7 @@ namespace rtfuse::drivers {
 
 enum class MpuSaturation : std::uint8_t {
   kFlag,    // the sample is delivered with the saturated quantity flagged
-  kReject,  // the whole sample is dropped (ReadStatus::kSaturated); not a chip fault
+  kReject,  // the whole sample is dropped (MpuReadStatus::kSaturated); not a chip fault
 };
 
 struct MpuConfig {
@@ -53,7 +53,7 @@ struct MpuConfig {
   MpuSaturation saturation = MpuSaturation::kFlag;
 };
 
-enum class ReadStatus : std::uint8_t {
+enum class MpuReadStatus : std::uint8_t {
   kOk,
   kSaturated,   // MpuSaturation::kReject and a saturated axis: sample dropped
   kNack,
@@ -65,7 +65,7 @@ enum class ReadStatus : std::uint8_t {
   kNotInitialised,
 };
 
-const char* to_string(ReadStatus s) noexcept;
+const char* to_string(MpuReadStatus s) noexcept;
 
 struct ImuReading {
   TimeNs stamp = 0;
@@ -105,7 +105,7 @@ class MpuDriver {
 
   // One burst read, stamped with `stamp` (the data-ready edge's kernel time,
   // or the clock at read time without a line). *out is written on kOk only.
-  ReadStatus read(TimeNs stamp, ImuReading* out) noexcept;
+  MpuReadStatus read(TimeNs stamp, ImuReading* out) noexcept;
 
   bool initialised() const noexcept { return initialised_; }
   // K consecutive failed reads: call init() again (cleared by a good read or init).
@@ -131,8 +131,8 @@ class MpuDriver {
   bool write(std::uint8_t reg, std::uint8_t value, const char* name) noexcept;
   bool configure() noexcept;
   bool verify(std::uint8_t reg, std::uint8_t expected, std::uint8_t actual, const char* name) noexcept;
-  ReadStatus fail(ReadStatus s) noexcept;
-  ReadStatus bus_failure(hal::HalStatus s) noexcept;
+  MpuReadStatus fail(MpuReadStatus s) noexcept;
+  MpuReadStatus bus_failure(hal::HalStatus s) noexcept;
 
   hal::I2cBus& bus_;
   hal::Clock& clock_;

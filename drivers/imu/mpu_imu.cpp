@@ -152,9 +152,9 @@ StepResult MpuImu::step(TimeNs edge_timeout_ns, ImuMeasurement* out) noexcept {
   if (!next_stamp(edge_timeout_ns, &stamp, &result)) return result;
 
   ImuReading reading;
-  const ReadStatus rs = driver_.read(stamp, &reading);
-  if (rs == ReadStatus::kOk) return deliver(reading, out);
-  if (rs == ReadStatus::kSaturated) return StepResult::kDropped;
+  const MpuReadStatus rs = driver_.read(stamp, &reading);
+  if (rs == MpuReadStatus::kOk) return deliver(reading, out);
+  if (rs == MpuReadStatus::kSaturated) return StepResult::kDropped;
   last_error_ = driver_.error();
   if (driver_.needs_reinit()) return reinit();
   return StepResult::kFault;

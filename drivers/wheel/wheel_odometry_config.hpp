@@ -7,12 +7,12 @@
 
 #include "core/time.hpp"
 #include "drivers/canopen/encoder_reading.hpp"
+#include "drivers/wheel/drive_kinematics.hpp"
 
 namespace rtfuse::drivers {
 
 constexpr int kMaxWheels = kMaxEncoderNodes;
 
-enum class DriveKinematics : std::uint8_t { kDifferential, kSkidSteer };
 enum class WheelSide : std::uint8_t { kLeft, kRight };
 
 struct WheelConfig {

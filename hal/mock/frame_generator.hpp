@@ -9,9 +9,9 @@
 
 namespace rtfuse::hal::mock {
 
-class FrameSource {
+class FrameGenerator {
  public:
-  virtual ~FrameSource() = default;
+  virtual ~FrameGenerator() = default;
   // Capture time of the next frame (CLOCK_MONOTONIC ns of the stream's
   // clock); a value < 0 means no more frames. The same value until fill()
   // takes that frame; strictly increasing from one frame to the next.

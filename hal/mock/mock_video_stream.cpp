@@ -19,7 +19,7 @@ VideoFormat yuyv_format(int width, int height, int fps, int buffers) noexcept {
   return f;
 }
 
-MockVideoStream::MockVideoStream(Clock& clock, FrameSource& source, const VideoFormat& format)
+MockVideoStream::MockVideoStream(Clock& clock, FrameGenerator& source, const VideoFormat& format)
     : clock_(clock), source_(source), format_(format) {
   nbuffers_ = format.buffers < 1 ? 1 : (format.buffers > kMaxVideoBuffers ? kMaxVideoBuffers : format.buffers);
   format_.buffers = nbuffers_;

@@ -1,5 +1,5 @@
 #pragma once
-// A VideoStream without a device: frames come from a FrameSource at the
+// A VideoStream without a device: frames come from a FrameGenerator at the
 // times it gives, on the stream's Clock (a SimClock jumps to the next frame,
 // a MonotonicClock sleeps until it). Buffers are allocated at construction
 // and behave like a V4L2 queue: a captured frame lands in a free buffer and
@@ -15,7 +15,7 @@
 #include <memory>
 
 #include "hal/clock.hpp"
-#include "hal/mock/frame_source.hpp"
+#include "hal/mock/frame_generator.hpp"
 #include "hal/video_stream.hpp"
 
 namespace rtfuse::hal::mock {
@@ -27,7 +27,7 @@ class MockVideoStream final : public VideoStream {
  public:
   // format is what open() would have negotiated; format.buffers buffers
   // (clamped to 1..kMaxVideoBuffers) of format.image_size bytes each.
-  MockVideoStream(Clock& clock, FrameSource& source, const VideoFormat& format);
+  MockVideoStream(Clock& clock, FrameGenerator& source, const VideoFormat& format);
   MockVideoStream(const MockVideoStream&) = delete;
   MockVideoStream& operator=(const MockVideoStream&) = delete;
 
@@ -106,7 +106,7 @@ class MockVideoStream final : public VideoStream {
   void set_error(const char* fmt, ...) noexcept __attribute__((format(printf, 2, 3)));
 
   Clock& clock_;
-  FrameSource& source_;
+  FrameGenerator& source_;
   VideoFormat format_;
   std::unique_ptr<std::uint8_t[]> storage_;
   Buffer buffers_[kMaxVideoBuffers];

@@ -27,7 +27,7 @@
 #include "transport/hal_record_codec.hpp"
 #include "runtime/devices/linux_hal.hpp"
 #include "runtime/pipeline/tick_pipeline.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 
 namespace {
 
@@ -191,13 +191,13 @@ int main(int argc, char** argv) {
   std::string error;
   rtfuse::TimeNs t0 = rtfuse::monotonic_now_ns();
   std::unique_ptr<rtfuse::hal::mock::SimClock> sim_clock;
-  std::unique_ptr<rtfuse::sim::SimulatedRobot> robot;
+  std::unique_ptr<rtfuse::sim::SimRobot> robot;
   std::unique_ptr<rtfuse::LinuxHal> linux_hal;
   rtfuse::HalBuses buses;
   if (cfg.hardware.backend == rtfuse::HalBackend::kSim) {
     t0 = 1'000'000'000;
     sim_clock = std::make_unique<rtfuse::hal::mock::SimClock>(t0);
-    robot = rtfuse::sim::SimulatedRobot::create(cfg, scenario_path, *sim_clock, t0, &error);
+    robot = rtfuse::sim::SimRobot::create(cfg, scenario_path, *sim_clock, t0, &error);
     if (!robot) {
       std::fprintf(stderr, "rtfuse-camera-snapshot: %s\n", error.c_str());
       return 1;

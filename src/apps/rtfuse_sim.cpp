@@ -24,7 +24,7 @@
 #include <CLI/CLI.hpp>
 
 #include "runtime/config/config_loader.hpp"
-#include "sim/simulated_drive.hpp"
+#include "sim/sim_drive.hpp"
 
 extern "C" void rtfuse_alloc_probe_steady(int steady) __attribute__((weak));
 
@@ -141,7 +141,7 @@ int main(int argc, char** argv) {
   }
   const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
   const rtfuse::sim::DriveResult r =
-      rtfuse::sim::run_simulated_drive(cfg, options, [tty](const rtfuse::sim::DriveProgress& p) {
+      rtfuse::sim::run_sim_drive(cfg, options, [tty](const rtfuse::sim::DriveProgress& p) {
         if (tty) std::fprintf(stderr, "\rsim: %.0f of %.0f s\033[K", p.sim_time_s, p.duration_s);
       });
   if (soak.armed) rtfuse_alloc_probe_steady(0);

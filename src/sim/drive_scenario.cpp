@@ -327,8 +327,8 @@ void read_imu(const Section& s, SimImuConfig& imu) {
                     "accel_noise_density_ug_rthz", "gyro_bias_dps", "accel_bias_mps2", "xyz_m", "rpy_deg",
                     "temperature_c"});
   switch (read_choice(s, "model", {"mpu6050", "mpu6500", "mpu9250"})) {
-    case 1: imu.model = SimImuModel::kMpu6500; break;
-    case 2: imu.model = SimImuModel::kMpu9250; break;
+    case 1: imu.model = MpuChip::kMpu6500; break;
+    case 2: imu.model = MpuChip::kMpu9250; break;
     default: break;
   }
   read_int(s, "address", imu.address, 0x08, 0x77);

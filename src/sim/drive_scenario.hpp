@@ -14,6 +14,8 @@
 #include <vector>
 
 #include "core/time.hpp"
+#include "drivers/wheel/drive_kinematics.hpp"
+#include "sim/devices/mpu_register_file.hpp"
 
 namespace rtfuse::sim {
 
@@ -45,7 +47,8 @@ struct MotionLimits {
   double max_yaw_accel_rad_s2 = 1.5;
 };
 
-enum class DriveKinematics : std::uint8_t { kDifferential, kSkidSteer };
+// The base moves as the wheel odometry assumes it does.
+using drivers::DriveKinematics;
 
 // Wheel order everywhere in the simulator: differential [left, right];
 // skid steer [left front, left rear, right front, right rear].
@@ -90,10 +93,9 @@ struct EncoderDropout {
   double duration_s = 0.0;
 };
 
-enum class SimImuModel : std::uint8_t { kMpu6050, kMpu6500, kMpu9250 };
 
 struct SimImuConfig {
-  SimImuModel model = SimImuModel::kMpu6050;
+  MpuChip model = MpuChip::kMpu6050;
   std::uint8_t address = 0x68;
   double rate_hz = 200.0;                        // data-ready edges per second
   int gyro_range_dps = 500;                      // what the robot's driver is expected to configure

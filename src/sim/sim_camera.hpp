@@ -11,7 +11,7 @@
 #include "drivers/camera/stereo_calibration.hpp"
 #include "geometry/rigid_transform.hpp"
 #include "hal/clock.hpp"
-#include "hal/mock/frame_source.hpp"
+#include "hal/mock/frame_generator.hpp"
 #include "hal/mock/mock_video_stream.hpp"
 #include "runtime/config/config.hpp"
 #include "sim/camera_world.hpp"
@@ -25,7 +25,7 @@ namespace rtfuse::sim {
 // rendering the scenario's world from the robot's pose through its mount.
 std::unique_ptr<SimDevice> make_sim_camera(const SimDeviceContext& ctx, std::string* error);
 
-class SimCamera final : public hal::mock::FrameSource, public SimDevice {
+class SimCamera final : public hal::mock::FrameGenerator, public SimDevice {
  public:
   // The camera section's calibration file and mode, the mount from the
   // config's static transforms. Null with *error when they do not fit.

@@ -1,4 +1,4 @@
-#include "sim/simulated_drive.hpp"
+#include "sim/sim_drive.hpp"
 
 #include <algorithm>
 
@@ -13,7 +13,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "runtime/pipeline/tick_pipeline.hpp"
 #include "sim/ground_truth.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 
 namespace rtfuse::sim {
 namespace {
@@ -65,14 +65,14 @@ double yaw_of(const double q[4]) {
 
 }  // namespace
 
-DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& options,
+DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
                                 const std::function<void(const DriveProgress&)>& progress) {
   DriveResult result;
   // Away from 0 so no stamp is ever mistaken for "unset".
   const TimeNs t0 = 1'000'000'000;
   hal::mock::SimClock clock(t0);
   std::string error;
-  std::unique_ptr<SimulatedRobot> robot = SimulatedRobot::create(cfg, options.scenario_path, clock, t0, &error);
+  std::unique_ptr<SimRobot> robot = SimRobot::create(cfg, options.scenario_path, clock, t0, &error);
   if (!robot) {
     result.error = error;
     return result;

@@ -15,7 +15,7 @@
 
 namespace rtfuse::sim {
 
-class SimulatedRobot;
+class SimRobot;
 
 struct DriveOptions {
   std::string scenario_path;  // empty: the config's [hardware] scenario
@@ -25,7 +25,7 @@ struct DriveOptions {
   // Called at every tick time t before the devices and the loop run up to
   // it: the fault-matrix tests inject faults into the robot's devices here
   // (everything runs on this one thread in lockstep).
-  std::function<void(TimeNs t, SimulatedRobot& robot)> before_tick;
+  std::function<void(TimeNs t, SimRobot& robot)> before_tick;
   // Every 1/truth_rate_hz: t, the truth and each instance's x y yaw (and a
   // map instance's map -> odom x y yaw) as one CSV line to this file; empty:
   // none. For the drive tests' time-based checks (recovery after an outage).
@@ -79,7 +79,7 @@ struct DriveProgress {
   double duration_s = 0.0;
 };
 
-DriveResult run_simulated_drive(const RuntimeConfig& cfg, const DriveOptions& options,
+DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
                                 const std::function<void(const DriveProgress&)>& progress);
 
 }  // namespace rtfuse::sim

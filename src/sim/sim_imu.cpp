@@ -11,14 +11,6 @@ namespace rtfuse::sim {
 
 namespace {
 
-sim::MpuModel chip_model(SimImuModel m) noexcept {
-  switch (m) {
-    case SimImuModel::kMpu6500: return sim::MpuModel::kMpu6500;
-    case SimImuModel::kMpu9250: return sim::MpuModel::kMpu9250;
-    case SimImuModel::kMpu6050: break;
-  }
-  return sim::MpuModel::kMpu6050;
-}
 
 // FS_SEL / AFS_SEL of a full-scale range, -1 if none matches.
 int gyro_fs_sel(int dps) noexcept {
@@ -39,7 +31,7 @@ SimImu::SimImu(const DriveScenario& scenario, const TruthTrajectory& truth, hal:
       // band up to Nyquist (the DLPF's band would be a refinement).
       gyro_sigma_(scenario.imu.gyro_noise_density * std::sqrt(0.5 * 1e9 / period_ns_)),
       accel_sigma_(scenario.imu.accel_noise_density * std::sqrt(0.5 * 1e9 / period_ns_)),
-      chip_(chip_model(scenario.imu.model)) {
+      chip_(scenario.imu.model) {
   const Eigen::Matrix3d r = geometry::rotation_from_rpy(cfg_.rpy_rad[0], cfg_.rpy_rad[1], cfg_.rpy_rad[2]);
   for (int i = 0; i < 3; ++i) {
     for (int j = 0; j < 3; ++j) r_[i][j] = r(i, j);
@@ -61,7 +53,7 @@ std::int64_t SimImu::first_sample_at_or_after(TimeNs t) const noexcept {
   return k;
 }
 
-ImuSample SimImu::ideal_sample(std::int64_t k) const noexcept {
+ImuChipReading SimImu::ideal_sample(std::int64_t k) const noexcept {
   const TruthState s = truth_.truth_at(ns_to_sec(sample_time(k) - t0_));
   const double w = s.yaw_rate;
   const double dw = s.yaw_accel;
@@ -73,7 +65,7 @@ ImuSample SimImu::ideal_sample(std::int64_t k) const noexcept {
   const double f[3] = {s.accel_body[0] - dw * py - w * w * px, s.accel_body[1] + dw * px - w * w * py,
                        s.accel_body[2] + sim::mpu::kStandardGravity};
   const double rate[3] = {0.0, 0.0, w};
-  ImuSample out;
+  ImuChipReading out;
   for (int i = 0; i < 3; ++i) {  // IMU axes: the transpose of base_link <- IMU
     out.accel_mps2[i] = r_[0][i] * f[0] + r_[1][i] * f[1] + r_[2][i] * f[2];
     out.gyro_rad_s[i] = r_[0][i] * rate[0] + r_[1][i] * rate[1] + r_[2][i] * rate[2];
@@ -82,8 +74,8 @@ ImuSample SimImu::ideal_sample(std::int64_t k) const noexcept {
   return out;
 }
 
-ImuSample SimImu::sample(std::int64_t k) const noexcept {
-  ImuSample s = ideal_sample(k);
+ImuChipReading SimImu::sample(std::int64_t k) const noexcept {
+  ImuChipReading s = ideal_sample(k);
   const auto index = static_cast<std::uint64_t>(k);
   for (int i = 0; i < 3; ++i) {
     const auto axis = static_cast<std::uint64_t>(i);
@@ -115,7 +107,7 @@ hal::HalStatus SimImu::wait_edge(TimeNs timeout_ns, hal::GpioEdge* out) noexcept
       return hal::HalStatus::kTimeout;
     }
     clock_.sleep_until(t);
-    ImuSample s = sample(next_);
+    ImuChipReading s = sample(next_);
     for (int i = 0; i < 3; ++i) {
       s.accel_mps2[i] += disturbance_accel_[i];
       s.gyro_rad_s[i] += disturbance_gyro_[i];

@@ -37,7 +37,7 @@ namespace rtfuse::sim {
 std::unique_ptr<SimDevice> make_sim_imu(const SimDeviceContext& ctx, std::string* error);
 
 // One sample before quantisation, in the IMU frame.
-struct ImuSample {
+struct ImuChipReading {
   double accel_mps2[3] = {0.0, 0.0, 0.0};  // specific force: what an accelerometer measures
   double gyro_rad_s[3] = {0.0, 0.0, 0.0};
   double temperature_c = 0.0;
@@ -59,9 +59,9 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimD
   TimeNs next_event_time() noexcept override { return next_edge_time(); }
   TimeNs sample_time(std::int64_t k) const noexcept;
   // Sample k as the chip's sensors see it, noise and bias included.
-  ImuSample sample(std::int64_t k) const noexcept;
+  ImuChipReading sample(std::int64_t k) const noexcept;
   // The noise-free value of the same (truth through the mounting).
-  ImuSample ideal_sample(std::int64_t k) const noexcept;
+  ImuChipReading ideal_sample(std::int64_t k) const noexcept;
   double gyro_noise_sigma() const noexcept { return gyro_sigma_; }
   double accel_noise_sigma() const noexcept { return accel_sigma_; }
 

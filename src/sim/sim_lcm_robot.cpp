@@ -1,4 +1,4 @@
-#include "sim/lcm_sim_robot.hpp"
+#include "sim/sim_lcm_robot.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -167,8 +167,8 @@ enum StreamId { kImu = 0, kOdom, kTruth, kStreams };
 
 }  // namespace
 
-struct LcmSimRobot::Impl {
-  Impl(const LcmSimConfig& c, TimeNs t0)
+struct SimLcmRobot::Impl {
+  Impl(const SimLcmConfig& c, TimeNs t0)
       : cfg(c),
         start(t0),
         path(c.figure_eight_radius_m, c.speed_mps),
@@ -211,7 +211,7 @@ struct LcmSimRobot::Impl {
   void build_odom(TimeNs stamp) noexcept;
   void build_truth(TimeNs stamp) noexcept;
 
-  LcmSimConfig cfg;  // owns the channel strings handed out in SimMessage
+  SimLcmConfig cfg;  // owns the channel strings handed out in SimMessage
   TimeNs start;
   FigureEight path;
   Gaussian imu_noise;
@@ -230,7 +230,7 @@ struct LcmSimRobot::Impl {
   double odom_x = 0.0, odom_y = 0.0, odom_yaw = 0.0;
 };
 
-void LcmSimRobot::Impl::build_imu(TimeNs stamp) noexcept {
+void SimLcmRobot::Impl::build_imu(TimeNs stamp) noexcept {
   const double t = seconds(stamp);
   const Kinematics k = path.at(t);
   auto& m = imu.msg;
@@ -262,7 +262,7 @@ void LcmSimRobot::Impl::build_imu(TimeNs stamp) noexcept {
   m.linear_acceleration.z = kGravity + biases.accel[2] + sa * imu_noise();
 }
 
-void LcmSimRobot::Impl::build_odom(TimeNs stamp) noexcept {
+void SimLcmRobot::Impl::build_odom(TimeNs stamp) noexcept {
   const double t = seconds(stamp);
   const Kinematics k = path.at(t);
   const LcmSimRobotSlip slip = slip_at(t, k);
@@ -291,7 +291,7 @@ void LcmSimRobot::Impl::build_odom(TimeNs stamp) noexcept {
   m.twist.twist.angular.z = vyaw;
 }
 
-void LcmSimRobot::Impl::build_truth(TimeNs stamp) noexcept {
+void SimLcmRobot::Impl::build_truth(TimeNs stamp) noexcept {
   const Kinematics k = path.at(seconds(stamp));
   auto& m = truth.msg;
   m.header.utime = ns_to_utime(stamp);
@@ -303,7 +303,7 @@ void LcmSimRobot::Impl::build_truth(TimeNs stamp) noexcept {
   m.twist.twist.angular.z = k.yaw_rate;
 }
 
-LcmSimRobot::LcmSimRobot(const LcmSimConfig& cfg, TimeNs start) : impl_(std::make_unique<Impl>(cfg, start)) {
+SimLcmRobot::SimLcmRobot(const SimLcmConfig& cfg, TimeNs start) : impl_(std::make_unique<Impl>(cfg, start)) {
   Impl& m = *impl_;
 
   m.imu.msg.header.frame_id = "base_link";
@@ -336,15 +336,15 @@ LcmSimRobot::LcmSimRobot(const LcmSimConfig& cfg, TimeNs start) : impl_(std::mak
   m.truth.finalize();
 }
 
-LcmSimRobot::~LcmSimRobot() = default;
+SimLcmRobot::~SimLcmRobot() = default;
 
-TimeNs LcmSimRobot::next_time() const noexcept {
+TimeNs SimLcmRobot::next_time() const noexcept {
   TimeNs t = kNever;
   for (const auto& s : impl_->streams) t = std::min(t, s.time());
   return t;
 }
 
-bool LcmSimRobot::next_due(TimeNs now, SimMessage* out) noexcept {
+bool SimLcmRobot::next_due(TimeNs now, SimMessage* out) noexcept {
   Impl& m = *impl_;
   int id = kImu;
   TimeNs stamp = m.streams[kImu].time();
@@ -386,18 +386,18 @@ bool LcmSimRobot::next_due(TimeNs now, SimMessage* out) noexcept {
   return true;
 }
 
-TruthPose LcmSimRobot::truth(TimeNs t) const noexcept {
+TruthPose SimLcmRobot::truth(TimeNs t) const noexcept {
   const Kinematics k = impl_->path.at(impl_->seconds(t));
   return TruthPose{k.x, k.y, k.yaw, k.v, k.yaw_rate};
 }
 
-double LcmSimRobot::period_s() const noexcept { return impl_->path.period(); }
+double SimLcmRobot::period_s() const noexcept { return impl_->path.period(); }
 
-LcmSimRobotSlip LcmSimRobot::slip(TimeNs t) const noexcept {
+LcmSimRobotSlip SimLcmRobot::slip(TimeNs t) const noexcept {
   const double s = impl_->seconds(t);
   return impl_->slip_at(s, impl_->path.at(s));
 }
 
-const SimBiases& LcmSimRobot::biases() const noexcept { return impl_->biases; }
+const SimBiases& SimLcmRobot::biases() const noexcept { return impl_->biases; }
 
 }  // namespace rtfuse::sim

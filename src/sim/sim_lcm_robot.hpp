@@ -40,12 +40,12 @@ struct SimBiases {
   double accel[3];  // m/s^2
 };
 
-class LcmSimRobot {
+class SimLcmRobot {
  public:
-  LcmSimRobot(const LcmSimConfig& cfg, TimeNs start);
-  ~LcmSimRobot();
-  LcmSimRobot(const LcmSimRobot&) = delete;
-  LcmSimRobot& operator=(const LcmSimRobot&) = delete;
+  SimLcmRobot(const SimLcmConfig& cfg, TimeNs start);
+  ~SimLcmRobot();
+  SimLcmRobot(const SimLcmRobot&) = delete;
+  SimLcmRobot& operator=(const SimLcmRobot&) = delete;
 
   // Stamp of the next message of any stream.
   TimeNs next_time() const noexcept;

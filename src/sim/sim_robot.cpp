@@ -1,4 +1,4 @@
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 
 #include <limits>
 
@@ -7,10 +7,10 @@
 
 namespace rtfuse::sim {
 
-std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg, const std::string& scenario_path,
+std::unique_ptr<SimRobot> SimRobot::create(const RuntimeConfig& cfg, const std::string& scenario_path,
                                                        hal::Clock& clock, TimeNs t0, std::string* error,
                                                        const std::string_view* scenario_text) {
-  std::unique_ptr<SimulatedRobot> r(new SimulatedRobot());
+  std::unique_ptr<SimRobot> r(new SimRobot());
   r->scenario_path_ = scenario_path.empty() ? cfg.hardware.scenario : scenario_path;
   const std::string& path = r->scenario_path_;
   if (path.empty()) {
@@ -45,7 +45,7 @@ std::unique_ptr<SimulatedRobot> SimulatedRobot::create(const RuntimeConfig& cfg,
   return r;
 }
 
-HalBuses SimulatedRobot::buses() {
+HalBuses SimRobot::buses() {
   HalBuses b;
   for (int i = 0; i < kMaxDeviceTypes; ++i) {
     if (devices_[i]) devices_[i]->provide(b.device[i], *clock_);
@@ -53,9 +53,9 @@ HalBuses SimulatedRobot::buses() {
   return b;
 }
 
-double SimulatedRobot::duration_s() const { return truth_->duration_s(); }
+double SimRobot::duration_s() const { return truth_->duration_s(); }
 
-TruthState SimulatedRobot::truth_at(TimeNs t) const noexcept { return truth_->truth_at(ns_to_sec(t - t0_)); }
+TruthState SimRobot::truth_at(TimeNs t) const noexcept { return truth_->truth_at(ns_to_sec(t - t0_)); }
 
 GroundTruthEncoder::GroundTruthEncoder() {
   fill_ground_truth(TruthState{}, 0, 0, &msg_);
@@ -69,7 +69,7 @@ const std::uint8_t* GroundTruthEncoder::encode(const TruthState& truth, TimeNs s
   return buf_.data();
 }
 
-TimeNs SimulatedRobot::next_event_time(std::string_view name) noexcept {
+TimeNs SimRobot::next_event_time(std::string_view name) noexcept {
   const int i = find_device_type(name);
   if (i < 0 || !devices_[i]) return std::numeric_limits<TimeNs>::max();
   return devices_[i]->next_event_time();

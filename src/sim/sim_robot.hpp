@@ -20,7 +20,7 @@
 
 namespace rtfuse::sim {
 
-class SimulatedRobot {
+class SimRobot {
  public:
   // Loads the scenario named by cfg.hardware.scenario (or `scenario_path`
   // when given) and makes the simulated counterpart of every device the
@@ -28,7 +28,7 @@ class SimulatedRobot {
   // robot configuration can talk to it (node ids, addresses, protocols).
   // scenario_text, when not null, is the scenario itself (a built-in one)
   // and scenario_path only names it in messages.
-  static std::unique_ptr<SimulatedRobot> create(const RuntimeConfig& cfg, const std::string& scenario_path,
+  static std::unique_ptr<SimRobot> create(const RuntimeConfig& cfg, const std::string& scenario_path,
                                                 hal::Clock& clock, TimeNs t0, std::string* error,
                                                 const std::string_view* scenario_text = nullptr);
 
@@ -54,7 +54,7 @@ class SimulatedRobot {
   TimeNs next_event_time(std::string_view name) noexcept;
 
  private:
-  SimulatedRobot() = default;
+  SimRobot() = default;
   std::string scenario_path_;
   DriveScenario scenario_;
   std::unique_ptr<TruthTrajectory> truth_;

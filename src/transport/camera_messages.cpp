@@ -48,7 +48,7 @@ bool fail(std::string* error, std::string message) {
   return false;
 }
 
-bool check_model(const StereoCameraModel& m, std::string* error) {
+bool check_model(const StereoCameraInfo& m, std::string* error) {
   const auto bad = [&](const char* what, double v, const char* want) {
     char text[64];
     std::snprintf(text, sizeof text, "%.9g", v);
@@ -64,7 +64,7 @@ bool check_model(const StereoCameraModel& m, std::string* error) {
   return true;
 }
 
-void fill_camera_info(const StereoCameraModel& m, const std::string& frame_id, double tx,
+void fill_camera_info(const StereoCameraInfo& m, const std::string& frame_id, double tx,
                       rtfuse::camera_info_t* info) {
   info->header.frame_id = frame_id;
   info->width = m.width;
@@ -128,7 +128,7 @@ struct CameraInfoEncoder::Impl {
 CameraInfoEncoder::CameraInfoEncoder(std::unique_ptr<Impl> impl) : impl_(std::move(impl)) {}
 CameraInfoEncoder::~CameraInfoEncoder() = default;
 
-std::unique_ptr<CameraInfoEncoder> CameraInfoEncoder::create(const StereoCameraModel& model, std::string* error) {
+std::unique_ptr<CameraInfoEncoder> CameraInfoEncoder::create(const StereoCameraInfo& model, std::string* error) {
   if (!check_model(model, error)) return nullptr;
   auto impl = std::make_unique<Impl>();
   fill_camera_info(model, model.left_frame_id, 0.0, &impl->left.msg);

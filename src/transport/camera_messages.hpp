@@ -10,7 +10,7 @@
 // buffer sized then. The runtime can encode on the publishing thread.
 //
 // Transport may not include drivers/, so the camera comes in as plain values
-// (StereoCameraModel), which the runtime copies from the driver's
+// (StereoCameraInfo), which the runtime copies from the driver's
 // drivers::StereoRectification.
 #include <cstdint>
 #include <memory>
@@ -22,7 +22,7 @@ namespace rtfuse::transport {
 
 // The rectified pair: both eyes share one undistorted pinhole; the right eye
 // sits at +baseline_m along the left rectified camera's x axis.
-struct StereoCameraModel {
+struct StereoCameraInfo {
   int width = 0;  // one eye, pixels
   int height = 0;
   double fx = 0.0, fy = 0.0, cx = 0.0, cy = 0.0;  // rectified pinhole, pixels
@@ -53,7 +53,7 @@ class CameraInfoEncoder {
   // nullptr and *error saying which value is wrong for a model with
   // non-positive sizes, focal lengths or baseline, or non-finite values.
   // Allocates (start-up).
-  static std::unique_ptr<CameraInfoEncoder> create(const StereoCameraModel& model, std::string* error);
+  static std::unique_ptr<CameraInfoEncoder> create(const StereoCameraInfo& model, std::string* error);
 
   ~CameraInfoEncoder();
   CameraInfoEncoder(const CameraInfoEncoder&) = delete;

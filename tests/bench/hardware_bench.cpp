@@ -40,9 +40,9 @@
 #include "runtime/devices/hardware.hpp"
 #include "runtime/devices/imu/imu_device.hpp"
 #include "runtime/replay/hal_recording.hpp"
-#include "sim/simulated_drive.hpp"
+#include "sim/sim_drive.hpp"
 #include "sim/sim_imu.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 #include "support/alloc_counter.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
@@ -110,7 +110,7 @@ void BM_HardwareTick(benchmark::State& state) {
   // Away from 0 so no stamp is ever mistaken for "unset" (as rtfuse-sim).
   const TimeNs t0 = 1'000'000'000;
   rtfuse::hal::mock::SimClock clock(t0);
-  std::unique_ptr<rtfuse::sim::SimulatedRobot> robot = rtfuse::sim::SimulatedRobot::create(*cfg, "", clock, t0, &error);
+  std::unique_ptr<rtfuse::sim::SimRobot> robot = rtfuse::sim::SimRobot::create(*cfg, "", clock, t0, &error);
   std::unique_ptr<rtfuse::FusionCore> core = robot ? rtfuse::FusionCore::create(*cfg, &error) : nullptr;
   std::unique_ptr<rtfuse::Hardware> hw = core ? rtfuse::Hardware::create(robot->buses(), *core, &error) : nullptr;
   if (!hw) {
@@ -134,7 +134,7 @@ void BM_HardwareTick(benchmark::State& state) {
   loop.period_ns = kPeriodNs;
   TimeNs t = t0;
   // What the IMU thread and the loop thread do in one period, in lockstep as
-  // run_simulated_drive does: the data-ready edges due by the tick, then the
+  // run_sim_drive does: the data-ready edges due by the tick, then the
   // tick (SYNC, TPDOs, wheel odometry, drain, fusion, snapshot).
   auto one_period = [&]() {
     t += kPeriodNs;
@@ -298,7 +298,7 @@ void make_ten_minute_drive(TenMinuteDrive& r) {
   options.scenario_path = r.scenario_path;
   options.record_path = r.record_path;
   options.config_text = r.config_text;
-  const rtfuse::sim::DriveResult d = rtfuse::sim::run_simulated_drive(*r.config, options, {});
+  const rtfuse::sim::DriveResult d = rtfuse::sim::run_sim_drive(*r.config, options, {});
   if (!d.ok) {
     r.error = "recording the drive: " + d.error;
     return;
@@ -398,7 +398,7 @@ void BM_SimulateTenMinuteDrive(benchmark::State& state) {
   double total_s = 0.0, sim_s = 0.0;
   for (auto _ : state) {
     const Clock::time_point start = Clock::now();
-    const rtfuse::sim::DriveResult d = rtfuse::sim::run_simulated_drive(*drive.config, options, {});
+    const rtfuse::sim::DriveResult d = rtfuse::sim::run_sim_drive(*drive.config, options, {});
     total_s += seconds_since(start);
     if (!d.ok || d.recording_lost > 0) {
       state.SkipWithError(("the drive failed: " + d.error).c_str());

@@ -15,14 +15,14 @@
 #include "drivers/camera/stereo_camera.hpp"
 #include "drivers/camera/zed_calibration.hpp"
 #include "hal/linux/monotonic_clock.hpp"
-#include "hal/mock/frame_source.hpp"
+#include "hal/mock/frame_generator.hpp"
 #include "hal/mock/mock_video_stream.hpp"
 #include "sim/camera_world.hpp"
 #include "sim/stereo_renderer.hpp"
 
 namespace rtfuse::bench {
 
-class LiveCameraRig final : public hal::mock::FrameSource {
+class LiveCameraRig final : public hal::mock::FrameGenerator {
  public:
   // Null with *error when the calibration cannot be read or the driver refuses.
   // period_ns: time between captures (33.3 ms = 30 fps; shorter makes a

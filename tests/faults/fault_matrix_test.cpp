@@ -29,8 +29,8 @@
 #include "sim/sim_camera.hpp"
 #include "sim/sim_encoders.hpp"
 #include "sim/sim_imu.hpp"
-#include "sim/simulated_drive.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_drive.hpp"
+#include "sim/sim_robot.hpp"
 
 namespace rtfuse {
 namespace {
@@ -77,7 +77,7 @@ const char* kConfig = RTFUSE_SOURCE_DIR "/config/sim.toml";
 const char* kScenario = RTFUSE_SOURCE_DIR "/config/scenarios/turns.toml";
 const char* kCameraScenario = RTFUSE_SOURCE_DIR "/config/scenarios/straight.toml";
 
-Trace drive(const Drive& d, const std::function<void(double, TimeNs, sim::SimulatedRobot&)>& inject) {
+Trace drive(const Drive& d, const std::function<void(double, TimeNs, sim::SimRobot&)>& inject) {
   const std::string text = read_file(kConfig);
   const ConfigLoadResult loaded = load_config_string(d.camera ? text : without_camera(text), kConfig);
   EXPECT_TRUE(loaded.config) << (loaded.errors.empty() ? "" : loaded.errors[0].to_string());
@@ -86,7 +86,7 @@ Trace drive(const Drive& d, const std::function<void(double, TimeNs, sim::Simula
   sim::DriveOptions o;
   o.scenario_path = d.camera ? kCameraScenario : kScenario;
   TimeNs t0 = -1;
-  o.before_tick = [&](TimeNs t, sim::SimulatedRobot& robot) {
+  o.before_tick = [&](TimeNs t, sim::SimRobot& robot) {
     if (t0 < 0) t0 = t;
     if (inject) inject(ns_to_sec(t - t0), t, robot);
   };
@@ -95,7 +95,7 @@ Trace drive(const Drive& d, const std::function<void(double, TimeNs, sim::Simula
     tr.snaps.push_back(s);
     tr.error.push_back(s.initialized ? std::hypot(s.state[0] - truth.x, s.state[1] - truth.y) : 0.0);
   };
-  const sim::DriveResult r = sim::run_simulated_drive(*loaded.config, o, nullptr);
+  const sim::DriveResult r = sim::run_sim_drive(*loaded.config, o, nullptr);
   EXPECT_TRUE(r.ok) << r.error;
   return tr;
 }
@@ -134,7 +134,7 @@ struct Row {
   const char* dev;
   const char* key;  // null: watch the device's level; else this counter rising
   bool camera = false;
-  std::function<void(double, TimeNs, sim::SimulatedRobot&)> inject;
+  std::function<void(double, TimeNs, sim::SimRobot&)> inject;
 };
 
 struct Measured {
@@ -240,7 +240,7 @@ constexpr double kFrom = 10.0;
 TEST(FaultMatrix, SilentCanNode) {
   Row r{"silent CAN node", "right encoder node off the bus 10-14 s (no heartbeat, no TPDO)", kFrom, kFrom + 4,
         "wheel right node 2", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) {
     if (t >= kFrom && t < kFrom + 4) robot.device<sim::SimEncoders>("wheel_encoders")->set_silent(1, true, now);
     if (t >= kFrom + 4) robot.device<sim::SimEncoders>("wheel_encoders")->set_silent(1, false, now);
   };
@@ -250,7 +250,7 @@ TEST(FaultMatrix, SilentCanNode) {
 TEST(FaultMatrix, StuckCounter) {
   Row r{"stuck counter", "right encoder's count frozen 10-14 s while driving", kFrom, kFrom + 4, "wheel right node 2",
         nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) {
     robot.device<sim::SimEncoders>("wheel_encoders")->set_stuck(1, t >= kFrom && t < kFrom + 4, now);
   };
   expect_handled(measure(r), 1.5, 0.5, 2.5, 1.5);
@@ -259,7 +259,7 @@ TEST(FaultMatrix, StuckCounter) {
 TEST(FaultMatrix, CounterJump) {
   Row r{"counter jump", "right encoder's count jumps by +5000 (1.2 wheel turns) at 10 s and stays", kFrom, kFrom,
         "wheel right node 2", "jump_events", false, {}};
-  r.inject = [done = false](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) mutable {
+  r.inject = [done = false](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) mutable {
     if (!done && t >= kFrom) {
       robot.device<sim::SimEncoders>("wheel_encoders")->jump(1, 5000);
       done = true;
@@ -271,7 +271,7 @@ TEST(FaultMatrix, CounterJump) {
 
 TEST(FaultMatrix, BusOff) {
   Row r{"bus-off", "CAN controller bus-off 10-12 s, then error-active", kFrom, kFrom + 2, "can bus", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) {
     robot.device<sim::SimEncoders>("wheel_encoders")->bus().set_state(t >= kFrom && t < kFrom + 2 ? hal::CanBusState::kBusOff
                                                                  : hal::CanBusState::kErrorActive);
   };
@@ -281,7 +281,7 @@ TEST(FaultMatrix, BusOff) {
 TEST(FaultMatrix, UnknownFramesFlood) {
   Row r{"unknown frames flooding the bus", "40 frames of id 0x555 per 5 ms tick (8000/s, a saturated 1 Mbit/s bus) 10-14 s",
         kFrom, kFrom + 4, "can bus", "unexpected_cob_ids", false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) {
     if (t < kFrom || t >= kFrom + 4) return;
     hal::CanFrame f;
     f.id = 0x555;
@@ -296,7 +296,7 @@ TEST(FaultMatrix, UnknownFramesFlood) {
 
 TEST(FaultMatrix, ImuNacks) {
   Row r{"IMU NACKs", "every I2C transfer to the MPU NACKed 10-12 s", kFrom, kFrom + 2, "imu", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) {
     robot.device<sim::SimImu>("imu")->chip().nack_next(t >= kFrom && t < kFrom + 2 ? 1'000'000 : 0);
   };
   expect_handled(measure(r), 0.2, 1.5, 1.0, 1.0);
@@ -304,14 +304,14 @@ TEST(FaultMatrix, ImuNacks) {
 
 TEST(FaultMatrix, FrozenImu) {
   Row r{"frozen IMU", "the MPU's data registers stop updating 10-14 s", kFrom, kFrom + 4, "imu", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) { robot.device<sim::SimImu>("imu")->chip().set_frozen(t >= kFrom && t < kFrom + 4); };
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) { robot.device<sim::SimImu>("imu")->chip().set_frozen(t >= kFrom && t < kFrom + 4); };
   expect_handled(measure(r), 0.2, 1.5, 1.0, 1.0);
 }
 
 TEST(FaultMatrix, Saturation) {
   Row r{"saturation", "an impact: +50 m/s^2 on the IMU's x (beyond +-4 g) and 10 rad/s on z (beyond +-500 deg/s) for 0.2 s at 10 s",
         kFrom, kFrom + 0.2, "imu", "saturated", false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) {
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) {
     const bool on = t >= kFrom && t < kFrom + 0.2;
     const double a[3] = {on ? 50.0 : 0.0, 0, 0};
     const double g[3] = {0, 0, on ? 10.0 : 0.0};
@@ -323,7 +323,7 @@ TEST(FaultMatrix, Saturation) {
 TEST(FaultMatrix, MissingDataReadyEdges) {
   Row r{"missing data-ready edges", "the MPU's data-ready edges lost 10-14 s (samples still latched)", kFrom, kFrom + 4,
         "imu", nullptr, false, {}};
-  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) { robot.device<sim::SimImu>("imu")->set_edges_lost(t >= kFrom && t < kFrom + 4); };
+  r.inject = [](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) { robot.device<sim::SimImu>("imu")->set_edges_lost(t >= kFrom && t < kFrom + 4); };
   expect_handled(measure(r), 0.5, 1.0, 1.0, 1.0);
 }
 
@@ -333,7 +333,7 @@ constexpr double kCamFrom = 6.0;
 TEST(FaultMatrix, CameraStall) {
   Row r{"camera stall", "no frames 6-9 s (the sensor stops; frames due meanwhile never exposed)", kCamFrom,
         kCamFrom + 3, "camera", nullptr, true, {}};
-  r.inject = [done = false](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) mutable {
+  r.inject = [done = false](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) mutable {
     if (!done && t >= kCamFrom && robot.device<sim::SimCamera>("camera") != nullptr) {
       robot.device<sim::SimCamera>("camera")->stall_until(robot.start_time() + sec_to_ns(kCamFrom + 3));
       done = true;
@@ -345,7 +345,7 @@ TEST(FaultMatrix, CameraStall) {
 TEST(FaultMatrix, CameraUnplugged) {
   Row r{"camera unplugged", "the stream goes away at 6 s and every reopen fails until 9 s", kCamFrom, kCamFrom + 3,
         "camera", nullptr, true, {}};
-  r.inject = [state = 0](double t, TimeNs now [[maybe_unused]], sim::SimulatedRobot& robot) mutable {
+  r.inject = [state = 0](double t, TimeNs now [[maybe_unused]], sim::SimRobot& robot) mutable {
     if (robot.device<sim::SimCamera>("camera") == nullptr) return;
     if (state == 0 && t >= kCamFrom) {
       robot.device<sim::SimCamera>("camera")->mock_stream().unplug();

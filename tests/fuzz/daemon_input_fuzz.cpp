@@ -27,7 +27,7 @@
 #include "runtime/devices/camera/camera_calibration.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/live/runtime.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 
 namespace {
 
@@ -100,7 +100,7 @@ pose_rejection_threshold = 5.0
 struct Daemon {
   rtfuse::RuntimeConfig cfg;  // what the robot and the runtime were made from, kept as rtfused keeps it
   rtfuse::hal::MonotonicClock clock;
-  std::unique_ptr<rtfuse::sim::SimulatedRobot> robot;
+  std::unique_ptr<rtfuse::sim::SimRobot> robot;
   std::unique_ptr<rtfuse::Runtime> runtime;
   std::atomic<std::int64_t> handled{0};  // input messages the LCM thread has dispatched
   std::atomic<std::int64_t> outputs{0};  // odometry and pose messages checked
@@ -199,7 +199,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   cfg.lcm_url = "memq://";
   std::string error;
   if (cfg.hardware.camera.enabled && !rtfuse::resolve_camera_calibration(&cfg.hardware.camera, &error)) fail(error);
-  d.robot = rtfuse::sim::SimulatedRobot::create(cfg, "", d.clock, rtfuse::monotonic_now_ns(), &error);
+  d.robot = rtfuse::sim::SimRobot::create(cfg, "", d.clock, rtfuse::monotonic_now_ns(), &error);
   if (!d.robot) fail(error);
   d.runtime = rtfuse::Runtime::create(cfg, d.robot->buses(), &error);
   if (!d.runtime) fail(error);

@@ -93,10 +93,10 @@ extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size
     }
     ImuReading r;
     stamp += 10'000'000;
-    const ReadStatus s = driver.read(stamp, &r);
+    const MpuReadStatus s = driver.read(stamp, &r);
     ++reads;
     FUZZ_CHECK(to_string(s) != nullptr, "every status has a name");
-    if (s != ReadStatus::kOk) continue;
+    if (s != MpuReadStatus::kOk) continue;
     FUZZ_CHECK(r.stamp == stamp, "the reading carries its stamp");
     FUZZ_CHECK(r.accel.allFinite() && r.gyro.allFinite() && std::isfinite(r.temperature_c), "finite");
     const double slack = 1.0 + 1e-9;

@@ -33,7 +33,7 @@ using rtfuse::hal::I2cDevBus;
 using rtfuse::hal::I2cRetryPolicy;
 using rtfuse::hal::I2cTransferMode;
 using rtfuse::drivers::MpuDriver;
-using rtfuse::drivers::ReadStatus;
+using rtfuse::drivers::MpuReadStatus;
 namespace reg = rtfuse::drivers::mpu_reg;
 
 constexpr std::uint8_t kAddr = 0x68;
@@ -203,7 +203,7 @@ TEST(I2cStub, MpuDriverInitialisesAndReadsThroughI2cDev) {
   EXPECT_EQ(cfgregs[3], 1 << 3);  // ACCEL_CONFIG AFS_SEL 1: +-4 g
 
   rtfuse::drivers::ImuReading r;
-  ASSERT_EQ(mpu.read(clock.now(), &r), ReadStatus::kOk) << mpu.error();
+  ASSERT_EQ(mpu.read(clock.now(), &r), MpuReadStatus::kOk) << mpu.error();
   EXPECT_NEAR(r.accel.z(), 9.80665, 1e-9);
   EXPECT_NEAR(r.accel.x(), 0.0, 1e-12);
   EXPECT_NEAR(r.gyro.x(), 10.0 * M_PI / 180.0, 1e-9);
@@ -217,17 +217,17 @@ TEST(I2cStub, MpuDriverInitialisesAndReadsThroughI2cDev) {
   // frozen signal chain; a changed sample is good again.
   int first_frozen = 0;
   for (int i = 2; i <= 8 && first_frozen == 0; ++i) {
-    if (mpu.read(clock.now(), &r) == ReadStatus::kFrozen) first_frozen = i;
+    if (mpu.read(clock.now(), &r) == MpuReadStatus::kFrozen) first_frozen = i;
   }
   EXPECT_EQ(first_frozen, cfg.frozen_reads);
   EXPECT_GE(mpu.stats().frozen, 1);
   put16(*bus, reg::kAccelXoutH + 0, 17);
-  ASSERT_EQ(mpu.read(clock.now(), &r), ReadStatus::kOk) << mpu.error();
+  ASSERT_EQ(mpu.read(clock.now(), &r), MpuReadStatus::kOk) << mpu.error();
   EXPECT_NEAR(r.accel.x(), 17 * 9.80665 / 8192.0, 1e-9);
 
   // Full scale on the accelerometer's y is flagged.
   put16(*bus, reg::kAccelXoutH + 2, 32767);
-  ASSERT_EQ(mpu.read(clock.now(), &r), ReadStatus::kOk);
+  ASSERT_EQ(mpu.read(clock.now(), &r), MpuReadStatus::kOk);
   EXPECT_TRUE(r.accel_saturated);
   EXPECT_EQ(mpu.stats().saturated, 1);
 }

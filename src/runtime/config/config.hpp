@@ -109,7 +109,7 @@ struct InstanceConfig {
 
 // The built-in simulated robot (config/sim.toml): a figure-eight drive with
 // ground truth, publishing imu_t and odometry_t on the sensors' channels.
-struct LcmSimConfig {
+struct SimLcmConfig {
   bool enabled = false;
   std::uint64_t seed = 1;
   double figure_eight_radius_m = 3.0;
@@ -154,7 +154,7 @@ struct RuntimeConfig {
   int num_sensors = 0;
   std::array<StaticTransformConfig, kMaxStaticTransforms> static_transforms{};
   int num_static_transforms = 0;
-  LcmSimConfig sim;
+  SimLcmConfig sim;
   HardwareConfig hardware;
   // instances[0] holds the first instance's name and filtered-fix channel
   // only: its filter and frame are `filter` and `world_frame` above.

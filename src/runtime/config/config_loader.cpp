@@ -636,7 +636,7 @@ void read_static_transforms(const Section& root, RuntimeConfig& cfg) {
   });
 }
 
-void read_sim(const Section& s, LcmSimConfig& sim) {
+void read_sim(const Section& s, SimLcmConfig& sim) {
   s.reject_unknown({"enabled", "seed", "radius", "speed", "imu_rate", "odom_rate", "imu_channel",
                     "odom_channel", "truth_channel", "gyro_noise", "gyro_bias", "accel_noise",
                     "accel_bias", "orientation_noise", "yaw_error", "yaw_error_time", "odom_speed_noise",

@@ -5,7 +5,7 @@
 // fusion core, the devices, the publisher and the recording tap; the rooms
 // around it own what differs: threads, timer and real-time settings (live,
 // runtime.hpp), log loading and comparison (hal_replay.hpp), the simulated
-// world and its clock (sim/simulated_drive.hpp).
+// world and its clock (sim/sim_drive.hpp).
 #include <cstdint>
 #include <memory>
 #include <string>

@@ -6,17 +6,17 @@ namespace rtfuse::sim {
 
 namespace mpu {
 
-std::uint8_t who_am_i(MpuModel model) noexcept {
+std::uint8_t who_am_i(MpuChip model) noexcept {
   switch (model) {
-    case MpuModel::kMpu6050: return 0x68;
-    case MpuModel::kMpu6500: return 0x70;
-    case MpuModel::kMpu9250: return 0x71;
+    case MpuChip::kMpu6050: return 0x68;
+    case MpuChip::kMpu6500: return 0x70;
+    case MpuChip::kMpu9250: return 0x71;
   }
   return 0x68;
 }
 
-std::uint8_t pwr_mgmt_1_reset_value(MpuModel model) noexcept {
-  return model == MpuModel::kMpu6050 ? kPwrSleep : std::uint8_t{0x01};
+std::uint8_t pwr_mgmt_1_reset_value(MpuChip model) noexcept {
+  return model == MpuChip::kMpu6050 ? kPwrSleep : std::uint8_t{0x01};
 }
 
 double accel_lsb_per_g(int afs_sel) noexcept {
@@ -29,8 +29,8 @@ double gyro_lsb_per_dps(int fs_sel) noexcept {
   return kLsb[fs_sel & 3];
 }
 
-double temperature_c(MpuModel model, std::int16_t raw) noexcept {
-  return model == MpuModel::kMpu6050 ? raw / 340.0 + 36.53 : raw / 333.87 + 21.0;
+double temperature_c(MpuChip model, std::int16_t raw) noexcept {
+  return model == MpuChip::kMpu6050 ? raw / 340.0 + 36.53 : raw / 333.87 + 21.0;
 }
 
 }  // namespace mpu
@@ -53,7 +53,7 @@ bool read_only(std::uint8_t reg) noexcept { return (reg >= mpu::kIntStatus && re
 
 }  // namespace
 
-MpuRegisterFile::MpuRegisterFile(MpuModel model) noexcept : model_(model) { reset_registers(); }
+MpuRegisterFile::MpuRegisterFile(MpuChip model) noexcept : model_(model) { reset_registers(); }
 
 void MpuRegisterFile::reset_registers() noexcept {
   for (auto& r : regs_) r = 0;
@@ -124,7 +124,7 @@ bool MpuRegisterFile::set_sample(const double accel_mps2[3], const double gyro_r
     g[i] = to_raw(gyro_rad_s[i] * g_scale);
   }
   const std::int16_t t =
-      model_ == MpuModel::kMpu6050 ? to_raw((temp_c - 36.53) * 340.0) : to_raw((temp_c - 21.0) * 333.87);
+      model_ == MpuChip::kMpu6050 ? to_raw((temp_c - 36.53) * 340.0) : to_raw((temp_c - 21.0) * 333.87);
   return set_raw_sample(a, t, g);
 }
 

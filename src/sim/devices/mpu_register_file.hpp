@@ -23,7 +23,7 @@
 
 namespace rtfuse::sim {
 
-enum class MpuModel : std::uint8_t { kMpu6050, kMpu6500, kMpu9250 };
+enum class MpuChip : std::uint8_t { kMpu6050, kMpu6500, kMpu9250 };
 
 namespace mpu {
 constexpr std::uint8_t kSmplrtDiv = 0x19;
@@ -49,21 +49,21 @@ constexpr std::uint8_t kDataRdyInt = 0x01;
 // The conversion the model uses from m/s^2 to g; a driver must use the same.
 constexpr double kStandardGravity = 9.80665;
 
-std::uint8_t who_am_i(MpuModel model) noexcept;
-std::uint8_t pwr_mgmt_1_reset_value(MpuModel model) noexcept;
+std::uint8_t who_am_i(MpuChip model) noexcept;
+std::uint8_t pwr_mgmt_1_reset_value(MpuChip model) noexcept;
 // LSB per g for AFS_SEL 0..3: 16384, 8192, 4096, 2048.
 double accel_lsb_per_g(int afs_sel) noexcept;
 // LSB per deg/s for FS_SEL 0..3: 131, 65.5, 32.8, 16.4.
 double gyro_lsb_per_dps(int fs_sel) noexcept;
 // Raw TEMP_OUT -> degrees C: raw/340 + 36.53 (6050), raw/333.87 + 21 (6500, 9250).
-double temperature_c(MpuModel model, std::int16_t raw) noexcept;
+double temperature_c(MpuChip model, std::int16_t raw) noexcept;
 }  // namespace mpu
 
 class MpuRegisterFile final : public hal::mock::I2cDevice {
  public:
-  explicit MpuRegisterFile(MpuModel model) noexcept;
+  explicit MpuRegisterFile(MpuChip model) noexcept;
 
-  MpuModel model() const noexcept { return model_; }
+  MpuChip model() const noexcept { return model_; }
 
   // --- the physical side -----------------------------------------------------
   // A new sample, converted with the current full-scale ranges, rounded to
@@ -109,7 +109,7 @@ class MpuRegisterFile final : public hal::mock::I2cDevice {
   void latch(const std::int16_t accel[3], std::int16_t temp, const std::int16_t gyro[3]) noexcept;
   bool raise_data_ready() noexcept;
 
-  MpuModel model_;
+  MpuChip model_;
   std::uint8_t regs_[256] = {};
   int reset_count_ = 0;
   int nack_remaining_ = 0;

@@ -23,7 +23,7 @@ using rtfuse::hal::mock::MockI2cBus;
 using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::ScriptedEdgeSource;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::sim::MpuModel;
+using Chip = rtfuse::sim::MpuChip;
 
 constexpr double kG = 9.80665;
 constexpr TimeNs kMs = 1'000'000;

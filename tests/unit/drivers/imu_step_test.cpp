@@ -23,7 +23,7 @@ using rtfuse::hal::mock::MockI2cBus;
 using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::ScriptedEdgeSource;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::sim::MpuModel;
+using Chip = rtfuse::sim::MpuChip;
 using Eigen::Vector3d;
 
 constexpr double kG = 9.80665;

@@ -16,12 +16,12 @@ using rtfuse::drivers::ImuReading;
 using rtfuse::drivers::MpuConfig;
 using rtfuse::drivers::MpuDriver;
 using rtfuse::drivers::MpuSaturation;
-using rtfuse::drivers::ReadStatus;
+using rtfuse::drivers::MpuReadStatus;
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::mock::MockI2cBus;
 using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::sim::MpuModel;
+using Chip = rtfuse::sim::MpuChip;
 
 constexpr double kG = 9.80665;
 
@@ -38,7 +38,7 @@ struct Rig {
     const double g[3] = {0.0, 0.0, 0.001 * n};
     ASSERT_TRUE(chip.set_sample(a, g, 25.0));
   }
-  ReadStatus read() { return driver.read(++stamp, &out); }
+  MpuReadStatus read() { return driver.read(++stamp, &out); }
   MpuRegisterFile chip;
   MockI2cBus bus;
   SimClock clock;
@@ -57,7 +57,7 @@ TEST(MpuDriverSaturation, AccelAtFullScaleIsFlaggedNotDropped) {
   const double a[3] = {3.0 * kG, 0.0, kG};  // beyond +-2 g on x
   const double g[3] = {0.1, 0.0, 0.0};
   ASSERT_TRUE(rig.chip.set_sample(a, g, 25.0));
-  ASSERT_EQ(rig.read(), ReadStatus::kOk);
+  ASSERT_EQ(rig.read(), MpuReadStatus::kOk);
   EXPECT_TRUE(rig.out.accel_saturated);
   EXPECT_FALSE(rig.out.gyro_saturated);
   EXPECT_EQ(rig.out.raw[0], 32767);
@@ -71,7 +71,7 @@ TEST(MpuDriverSaturation, GyroAtNegativeFullScaleIsFlagged) {
     const std::int16_t a[3] = {10, 20, 8192};
     const std::int16_t g[3] = {5, neg, 7};
     ASSERT_TRUE(rig.chip.set_raw_sample(a, 0, g));
-    ASSERT_EQ(rig.read(), ReadStatus::kOk);
+    ASSERT_EQ(rig.read(), MpuReadStatus::kOk);
     EXPECT_TRUE(rig.out.gyro_saturated) << neg;
     EXPECT_FALSE(rig.out.accel_saturated) << neg;
   }
@@ -79,7 +79,7 @@ TEST(MpuDriverSaturation, GyroAtNegativeFullScaleIsFlagged) {
   const std::int16_t a[3] = {10, 20, 8192};
   const std::int16_t g[3] = {5, -32766, 32766};
   ASSERT_TRUE(rig.chip.set_raw_sample(a, 0, g));
-  ASSERT_EQ(rig.read(), ReadStatus::kOk);
+  ASSERT_EQ(rig.read(), MpuReadStatus::kOk);
   EXPECT_FALSE(rig.out.gyro_saturated);
   EXPECT_EQ(rig.driver.stats().saturated, 2);
 }
@@ -93,7 +93,7 @@ TEST(MpuDriverSaturation, RejectPolicyDropsTheSampleWithoutCountingAFault) {
   const double g[3] = {0.0, 0.0, 5.0};  // 286 deg/s
   ASSERT_TRUE(rig.chip.set_sample(a, g, 25.0));
   rig.out.stamp = -1;
-  EXPECT_EQ(rig.read(), ReadStatus::kSaturated);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kSaturated);
   EXPECT_EQ(rig.out.stamp, -1);  // untouched
   EXPECT_EQ(rig.driver.stats().saturated, 1);
   EXPECT_EQ(rig.driver.stats().consecutive_failures, 0);
@@ -106,16 +106,16 @@ TEST(MpuDriverFrozen, SameBytesNTimesIsFrozenThenReinitRecovers) {
   c.failures_before_reinit = 2;
   Rig rig(c);
   rig.sample();
-  ASSERT_EQ(rig.read(), ReadStatus::kOk);
+  ASSERT_EQ(rig.read(), MpuReadStatus::kOk);
   rig.chip.set_frozen(true);
   rig.sample();  // data registers keep the previous bytes
-  EXPECT_EQ(rig.read(), ReadStatus::kOk);  // seen twice: could still be a coincidence
+  EXPECT_EQ(rig.read(), MpuReadStatus::kOk);  // seen twice: could still be a coincidence
   rig.sample();
-  EXPECT_EQ(rig.read(), ReadStatus::kFrozen);  // three times
+  EXPECT_EQ(rig.read(), MpuReadStatus::kFrozen);  // three times
   EXPECT_FALSE(rig.driver.needs_reinit());
   EXPECT_TRUE(contains(rig.driver.error(), "frozen")) << rig.driver.error();
   rig.sample();
-  EXPECT_EQ(rig.read(), ReadStatus::kFrozen);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kFrozen);
   EXPECT_TRUE(rig.driver.needs_reinit());
   EXPECT_EQ(rig.driver.stats().frozen, 2);
   EXPECT_EQ(rig.driver.stats().reinit_requests, 1);
@@ -125,7 +125,7 @@ TEST(MpuDriverFrozen, SameBytesNTimesIsFrozenThenReinitRecovers) {
   EXPECT_FALSE(rig.driver.needs_reinit());
   EXPECT_EQ(rig.chip.reset_count(), 2);
   rig.sample();
-  EXPECT_EQ(rig.read(), ReadStatus::kOk);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kOk);
   EXPECT_EQ(rig.driver.stats().good_reads, 3);
 }
 
@@ -134,7 +134,7 @@ TEST(MpuDriverFrozen, ZeroDisablesTheCheck) {
   c.frozen_reads = 0;
   Rig rig(c);
   rig.sample();
-  for (int i = 0; i < 20; ++i) EXPECT_EQ(rig.read(), ReadStatus::kOk);
+  for (int i = 0; i < 20; ++i) EXPECT_EQ(rig.read(), MpuReadStatus::kOk);
 }
 
 TEST(MpuDriverBus, NackRetriesThenFailureThenReinitRequest) {
@@ -143,19 +143,19 @@ TEST(MpuDriverBus, NackRetriesThenFailureThenReinitRequest) {
   Rig rig(c);
   rig.sample();
   rig.chip.nack_next(2);  // the bus's 3 attempts absorb two NACKs
-  EXPECT_EQ(rig.read(), ReadStatus::kOk);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kOk);
   EXPECT_EQ(rig.driver.stats().nacks, 0);
 
   rig.out.stamp = -1;
   rig.chip.nack_next(3);  // retries exhausted
-  EXPECT_EQ(rig.read(), ReadStatus::kNack);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kNack);
   EXPECT_EQ(rig.out.stamp, -1);
   EXPECT_TRUE(contains(rig.driver.error(), "NACK")) << rig.driver.error();
   rig.bus.fail_next(HalStatus::kBusError, 3);
-  EXPECT_EQ(rig.read(), ReadStatus::kBusError);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kBusError);
   EXPECT_FALSE(rig.driver.needs_reinit());
   rig.bus.fail_next(HalStatus::kTimeout, 1);  // not retried by the bus
-  EXPECT_EQ(rig.read(), ReadStatus::kTimeout);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kTimeout);
   EXPECT_TRUE(rig.driver.needs_reinit());
   const auto& s = rig.driver.stats();
   EXPECT_EQ(s.nacks, 1);
@@ -166,7 +166,7 @@ TEST(MpuDriverBus, NackRetriesThenFailureThenReinitRequest) {
 
   // A good read clears the request: the fault was transient.
   rig.sample();
-  EXPECT_EQ(rig.read(), ReadStatus::kOk);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kOk);
   EXPECT_FALSE(rig.driver.needs_reinit());
   EXPECT_EQ(rig.driver.stats().consecutive_failures, 0);
 }
@@ -175,33 +175,33 @@ TEST(MpuDriverImpossible, AllZeroAllOnesAndHotTemperature) {
   Rig rig;
   const std::int16_t zero[3] = {0, 0, 0};
   ASSERT_TRUE(rig.chip.set_raw_sample(zero, 0, zero));
-  EXPECT_EQ(rig.read(), ReadStatus::kImpossible);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kImpossible);
   EXPECT_TRUE(contains(rig.driver.error(), "all 0x00")) << rig.driver.error();
 
   const std::int16_t ones[3] = {-1, -1, -1};
   ASSERT_TRUE(rig.chip.set_raw_sample(ones, -1, ones));
-  EXPECT_EQ(rig.read(), ReadStatus::kImpossible);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kImpossible);
   EXPECT_TRUE(contains(rig.driver.error(), "all 0xff")) << rig.driver.error();
 
   const std::int16_t a[3] = {1, 2, 8192};
   ASSERT_TRUE(rig.chip.set_raw_sample(a, 20000, a));  // 95.4 C on a 6050
-  EXPECT_EQ(rig.read(), ReadStatus::kImpossible);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kImpossible);
   EXPECT_TRUE(contains(rig.driver.error(), "temperature 95 C")) << rig.driver.error();
   ASSERT_TRUE(rig.chip.set_raw_sample(a, -26000, a));  // -39.9 C: cold but possible
-  EXPECT_EQ(rig.read(), ReadStatus::kOk);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kOk);
   EXPECT_EQ(rig.driver.stats().impossible, 3);
 }
 
 TEST(MpuDriverImpossible, AsleepChipReadsZerosAfterAReset) {
   Rig rig;
   rig.sample();
-  ASSERT_EQ(rig.read(), ReadStatus::kOk);
+  ASSERT_EQ(rig.read(), MpuReadStatus::kOk);
   // Someone reset the chip behind the driver's back: asleep, data registers 0.
   ASSERT_EQ(rig.bus.write_register(0x68, 0x6B, 0x80), HalStatus::kOk);
   const double a[3] = {0.0, 0.0, kG};
   const double g[3] = {0.0, 0.0, 0.0};
   EXPECT_FALSE(rig.chip.set_sample(a, g, 25.0));  // asleep: no sample
-  EXPECT_EQ(rig.read(), ReadStatus::kImpossible);
+  EXPECT_EQ(rig.read(), MpuReadStatus::kImpossible);
 }
 
 TEST(MpuDriverState, ReadBeforeInitIsRefused) {
@@ -211,7 +211,7 @@ TEST(MpuDriverState, ReadBeforeInitIsRefused) {
   ASSERT_TRUE(bus.attach(0x68, chip));
   MpuDriver d(bus, clock, MpuConfig{});
   ImuReading r;
-  EXPECT_EQ(d.read(1, &r), ReadStatus::kNotInitialised);
+  EXPECT_EQ(d.read(1, &r), MpuReadStatus::kNotInitialised);
   EXPECT_EQ(bus.total_transfers(), 0);
 }
 

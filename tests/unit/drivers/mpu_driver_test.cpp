@@ -15,11 +15,11 @@ namespace {
 using rtfuse::drivers::ImuReading;
 using rtfuse::drivers::MpuConfig;
 using rtfuse::drivers::MpuDriver;
-using rtfuse::drivers::ReadStatus;
+using rtfuse::drivers::MpuReadStatus;
 using rtfuse::hal::mock::MockI2cBus;
 using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::SimClock;
-using Chip = rtfuse::sim::MpuModel;
+using Chip = rtfuse::sim::MpuChip;
 using Model = rtfuse::drivers::MpuModel;
 using Eigen::Vector3d;
 
@@ -178,7 +178,7 @@ TEST_P(MpuDriverRanges, ScalesExactCountsToSi) {
   const std::int16_t gyro[3] = {p.raw_100_dps, 0, static_cast<std::int16_t>(-p.raw_100_dps)};
   ASSERT_TRUE(rig.chip.set_raw_sample(accel, 0, gyro));
   ImuReading r;
-  ASSERT_EQ(rig.driver.read(1234, &r), ReadStatus::kOk) << rig.driver.error();
+  ASSERT_EQ(rig.driver.read(1234, &r), MpuReadStatus::kOk) << rig.driver.error();
   EXPECT_EQ(r.stamp, 1234);
   EXPECT_NEAR(r.accel.x(), kG, 1e-12);
   EXPECT_NEAR(r.accel.y(), -0.5 * kG, 1e-12);
@@ -216,7 +216,7 @@ TEST(MpuDriverScaling, RoundTripsPhysicalValuesWithinHalfAnLsb) {
   const double g[3] = {0.123, -15.0, 4.4};
   ASSERT_TRUE(rig.chip.set_sample(a, g, 31.0));
   ImuReading r;
-  ASSERT_EQ(rig.driver.read(1, &r), ReadStatus::kOk);
+  ASSERT_EQ(rig.driver.read(1, &r), MpuReadStatus::kOk);
   const double a_lsb = kG / 4096.0, g_lsb = kDegToRad / 32.8;
   for (int i = 0; i < 3; ++i) {
     EXPECT_NEAR(r.accel[i], a[i], 0.5 * a_lsb + 1e-12);
@@ -236,7 +236,7 @@ TEST(MpuDriverMounting, UpsideDownImuReadsUprightInBaseLink) {
   const double g[3] = {0.1, 0.2, 0.3};
   ASSERT_TRUE(rig.chip.set_sample(a, g, 25.0));
   ImuReading r;
-  ASSERT_EQ(rig.driver.read(1, &r), ReadStatus::kOk);
+  ASSERT_EQ(rig.driver.read(1, &r), MpuReadStatus::kOk);
   const double a_lsb = kG / 8192.0, g_lsb = kDegToRad / 65.5;
   EXPECT_NEAR(r.accel.x(), 0.5, a_lsb);
   EXPECT_NEAR(r.accel.y(), 0.0, a_lsb);
@@ -257,7 +257,7 @@ TEST(MpuDriverMounting, YawedImuSwapsAxes) {
   const double g[3] = {0.0, 0.0, 0.0};
   ASSERT_TRUE(rig.chip.set_sample(a, g, 25.0));
   ImuReading r;
-  ASSERT_EQ(rig.driver.read(1, &r), ReadStatus::kOk);
+  ASSERT_EQ(rig.driver.read(1, &r), MpuReadStatus::kOk);
   const double a_lsb = kG / 8192.0;
   EXPECT_NEAR(r.accel.x(), 0.0, a_lsb);
   EXPECT_NEAR(r.accel.y(), 2.0, a_lsb);
@@ -279,7 +279,7 @@ TEST_P(MpuDriverTemperature, PerModelFormula) {
   const std::int16_t g[3] = {1, 2, 3};
   ASSERT_TRUE(rig.chip.set_raw_sample(a, GetParam().raw, g));
   ImuReading r;
-  ASSERT_EQ(rig.driver.read(1, &r), ReadStatus::kOk) << rig.driver.error();
+  ASSERT_EQ(rig.driver.read(1, &r), MpuReadStatus::kOk) << rig.driver.error();
   EXPECT_NEAR(r.temperature_c, GetParam().celsius, 1e-9);
 }
 

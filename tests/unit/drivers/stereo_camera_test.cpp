@@ -17,7 +17,7 @@
 
 #include "core/frame_pool.hpp"
 #include "drivers/camera/zed_usb_hint.hpp"
-#include "hal/mock/frame_source.hpp"
+#include "hal/mock/frame_generator.hpp"
 #include "hal/mock/mock_video_stream.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
@@ -58,7 +58,7 @@ void paint(std::uint32_t seq, std::uint8_t* data) {
 }
 
 // A frame every kPeriod from kStart, painted with paint().
-class PatternSource final : public hal::mock::FrameSource {
+class PatternSource final : public hal::mock::FrameGenerator {
  public:
   TimeNs next_frame_time() noexcept override { return kStart + static_cast<TimeNs>(taken_) * kPeriod; }
   std::uint32_t fill(TimeNs, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override {

@@ -15,7 +15,7 @@ constexpr TimeNs kPeriod = 10 * kMs;  // 100 fps
 constexpr TimeNs kFirst = 1'000 * kMs;
 
 // Frames every kPeriod from kFirst; paints each frame's low sequence byte.
-class PatternSource final : public FrameSource {
+class PatternSource final : public FrameGenerator {
  public:
   explicit PatternSource(int count = 1'000'000) : count_(count) {}
   TimeNs next_frame_time() noexcept override { return taken_ < count_ ? kFirst + taken_ * kPeriod : -1; }
@@ -242,7 +242,7 @@ TEST(MockVideoStreamEnd, ExhaustedSourceTimesOut) {
   EXPECT_EQ(clock.now(), kFirst + kPeriod + 100 * kMs);
 }
 
-class StuckSource final : public FrameSource {
+class StuckSource final : public FrameGenerator {
  public:
   TimeNs next_frame_time() noexcept override { return kFirst; }
   std::uint32_t fill(TimeNs, std::uint32_t, std::uint8_t*, std::uint32_t) noexcept override { return 0; }

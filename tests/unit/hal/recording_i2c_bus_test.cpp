@@ -15,7 +15,7 @@ using rtfuse::hal::BusEventKind;
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::RecordingI2cBus;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::sim::MpuModel;
+using rtfuse::sim::MpuChip;
 using rtfuse::sim::MpuRegisterFile;
 using rtfuse::hal::mock::SimClock;
 namespace mpu = rtfuse::sim::mpu;
@@ -30,7 +30,7 @@ struct Rig {
     return ev;
   }
   SimClock clock{7'000};
-  MpuRegisterFile chip{MpuModel::kMpu6500};
+  MpuRegisterFile chip{MpuChip::kMpu6500};
   MockI2cBus bus;
   SpscRing<BusEvent> ring{64};
   RecordingI2cBus rec{bus, ring, 1, &clock};
@@ -89,7 +89,7 @@ TEST(HalRecordingI2cBus, FailuresAndRetriesAreRecorded) {
 }
 
 TEST(HalRecordingI2cBus, FullRingCountsAndCallsDoNotAllocate) {
-  MpuRegisterFile chip(MpuModel::kMpu6050);
+  MpuRegisterFile chip(MpuChip::kMpu6050);
   MockI2cBus bus;
   ASSERT_TRUE(bus.attach(kAddr, chip));
   SpscRing<BusEvent> ring(4);

@@ -90,7 +90,7 @@ TEST(HalReplayBuses, ReplayReturnsWhatTheRecordedBusesReturned) {
   // --- record
   mock::SimClock sim(1'000'000'000);
   mock::MockCanBus can({}, &sim);
-  sim::MpuRegisterFile chip(sim::MpuModel::kMpu6050);
+  sim::MpuRegisterFile chip(sim::MpuChip::kMpu6050);
   mock::MockI2cBus i2c;
   ASSERT_TRUE(i2c.attach(0x68, chip));
   ASSERT_EQ(i2c.write_register(0x68, 0x6B, 0x01), HalStatus::kOk);

@@ -21,7 +21,7 @@ constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kPeriod = 10 * kMs;
 constexpr TimeNs kFirst = 1'000 * kMs;
 
-class PatternSource final : public mock::FrameSource {
+class PatternSource final : public mock::FrameGenerator {
  public:
   TimeNs next_frame_time() noexcept override { return kFirst + taken_ * kPeriod; }
   std::uint32_t fill(TimeNs, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override {

@@ -11,7 +11,7 @@
 #include <memory>
 #include <string>
 
-#include "hal/mock/frame_source.hpp"
+#include "hal/mock/frame_generator.hpp"
 #include "hal/mock/mock_video_stream.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "runtime/config/config_loader.hpp"
@@ -43,7 +43,7 @@ fps = 30
 )";
 
 // A grey frame every kPeriod, its shade from the sequence number.
-class ShadeSource final : public hal::mock::FrameSource {
+class ShadeSource final : public hal::mock::FrameGenerator {
  public:
   TimeNs next_frame_time() noexcept override { return kStart + static_cast<TimeNs>(taken_) * kPeriod; }
   std::uint32_t fill(TimeNs, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override {

@@ -381,7 +381,7 @@ TEST(Hardware, SteadyStateTicksAllocateNothing) {
 // An MPU-6050 on a mock I2C bus with a scripted data-ready line; the IMU
 // thread's steps are interleaved with the loop's ticks.
 struct ImuRig {
-  explicit ImuRig(const std::string& text) : chip(sim::MpuModel::kMpu6050), edges(256, &clock) {
+  explicit ImuRig(const std::string& text) : chip(sim::MpuChip::kMpu6050), edges(256, &clock) {
     EXPECT_TRUE(i2c.attach(0x68, chip));
     std::string err;
     core = FusionCore::create(load(text), &err);

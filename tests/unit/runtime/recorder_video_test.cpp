@@ -28,7 +28,7 @@ using transport::RecordingInfo;
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kFirst = 1'000 * kMs;
 
-class Source final : public hal::mock::FrameSource {
+class Source final : public hal::mock::FrameGenerator {
  public:
   TimeNs next_frame_time() noexcept override { return kFirst + taken_ * 33 * kMs; }
   std::uint32_t fill(TimeNs, std::uint32_t sequence, std::uint8_t* data, std::uint32_t capacity) noexcept override {

@@ -208,7 +208,7 @@ temperature_c = 40.0
   EXPECT_EQ(sc.dropouts[0].start_s, 4.0);
   EXPECT_EQ(sc.dropouts[0].duration_s, 2.0);
   const SimImuConfig& imu = sc.imu;
-  EXPECT_EQ(imu.model, SimImuModel::kMpu9250);
+  EXPECT_EQ(imu.model, MpuChip::kMpu9250);
   EXPECT_EQ(imu.address, 0x69);
   EXPECT_EQ(imu.rate_hz, 500.0);
   EXPECT_EQ(imu.gyro_range_dps, 1000);

@@ -20,7 +20,7 @@
 #include "runtime/devices/device_registry.hpp"
 #include "runtime/devices/frame_consumer.hpp"
 #include "runtime/pipeline/tick_pipeline.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 #include "support/sim_toml.hpp"
 
 namespace {
@@ -115,7 +115,7 @@ class FrameConsumers : public ::testing::Test {
     const TimeNs t0 = 1'000'000'000;
     hal::mock::SimClock clock(t0);
     std::string err;
-    auto robot = sim::SimulatedRobot::create(cfg, "", clock, t0, &err);
+    auto robot = sim::SimRobot::create(cfg, "", clock, t0, &err);
     EXPECT_TRUE(robot) << err;
     if (!robot) return out;
     NullSink sink;

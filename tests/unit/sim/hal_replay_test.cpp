@@ -20,7 +20,7 @@
 #include "runtime/config/config_loader.hpp"
 #include "runtime/pipeline/recording_tap.hpp"
 #include "runtime/replay/hal_recording.hpp"
-#include "sim/simulated_drive.hpp"
+#include "sim/sim_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
 #include "support/sim_toml.hpp"
@@ -75,7 +75,7 @@ class HalReplay : public testing::Test {
     opt.scenario_path = *scenario_path_;
     opt.record_path = *record_path_;
     opt.config_text = *config_text_;
-    drive_ = new sim::DriveResult(sim::run_simulated_drive(*config_, opt, nullptr));
+    drive_ = new sim::DriveResult(sim::run_sim_drive(*config_, opt, nullptr));
   }
   static void TearDownTestSuite() {
     std::remove(scenario_path_->c_str());

@@ -13,7 +13,7 @@ using rtfuse::hal::HalStatus;
 using rtfuse::hal::I2cRetryPolicy;
 using rtfuse::hal::mock::I2cTransferRecord;
 using rtfuse::hal::mock::MockI2cBus;
-using rtfuse::sim::MpuModel;
+using rtfuse::sim::MpuChip;
 using rtfuse::sim::MpuRegisterFile;
 namespace mpu = rtfuse::sim::mpu;
 
@@ -27,7 +27,7 @@ std::int16_t be16(const std::uint8_t* p) {
 
 // A chip on a bus, awake, data-ready enabled: what a driver has after init.
 struct Rig {
-  explicit Rig(MpuModel model = MpuModel::kMpu6050) : chip(model) {
+  explicit Rig(MpuChip model = MpuChip::kMpu6050) : chip(model) {
     EXPECT_TRUE(bus.attach(kAddr, chip));
     EXPECT_EQ(bus.write_register(kAddr, mpu::kPwrMgmt1, 0x01), HalStatus::kOk);
     EXPECT_EQ(bus.write_register(kAddr, mpu::kIntEnable, mpu::kDataRdyEn), HalStatus::kOk);
@@ -43,7 +43,7 @@ struct Rig {
 };
 
 struct WhoCase {
-  MpuModel model;
+  MpuChip model;
   std::uint8_t who;
   std::uint8_t pwr_reset;
 };
@@ -81,12 +81,12 @@ TEST_P(HalMockMpuModel, WhoAmIAndResetDefaults) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Models, HalMockMpuModel,
-                         ::testing::Values(WhoCase{MpuModel::kMpu6050, 0x68, 0x40},
-                                           WhoCase{MpuModel::kMpu6500, 0x70, 0x01},
-                                           WhoCase{MpuModel::kMpu9250, 0x71, 0x01}));
+                         ::testing::Values(WhoCase{MpuChip::kMpu6050, 0x68, 0x40},
+                                           WhoCase{MpuChip::kMpu6500, 0x70, 0x01},
+                                           WhoCase{MpuChip::kMpu9250, 0x71, 0x01}));
 
 TEST(HalMockMpu, AsleepChipDoesNotSampleUntilWoken) {
-  MpuRegisterFile chip(MpuModel::kMpu6050);
+  MpuRegisterFile chip(MpuChip::kMpu6050);
   EXPECT_TRUE(chip.asleep());
   const double a[3] = {0, 0, kG};
   const double g[3] = {0, 0, 0};
@@ -155,9 +155,9 @@ TEST(HalMockMpu, SaturatesAtFullScaleLikeTheChip) {
 }
 
 TEST(HalMockMpu, TemperatureScalingPerModel) {
-  Rig r6050(MpuModel::kMpu6050);
-  Rig r6500(MpuModel::kMpu6500);
-  Rig r9250(MpuModel::kMpu9250);
+  Rig r6050(MpuChip::kMpu6050);
+  Rig r6500(MpuChip::kMpu6500);
+  Rig r9250(MpuChip::kMpu9250);
   const double a[3] = {0, 0, 0};
   const double g[3] = {0, 0, 0};
   ASSERT_TRUE(r6050.chip.set_sample(a, g, 25.0));
@@ -167,8 +167,8 @@ TEST(HalMockMpu, TemperatureScalingPerModel) {
   EXPECT_EQ(r6050.chip.peek16(mpu::kTempOutH), -3920);
   EXPECT_EQ(r6500.chip.peek16(mpu::kTempOutH), 1335);
   EXPECT_EQ(r9250.chip.peek16(mpu::kTempOutH), 0);
-  EXPECT_NEAR(mpu::temperature_c(MpuModel::kMpu6050, -3920), 25.0, 0.5 / 340.0);
-  EXPECT_NEAR(mpu::temperature_c(MpuModel::kMpu6500, 1335), 25.0, 0.5 / 333.87);
+  EXPECT_NEAR(mpu::temperature_c(MpuChip::kMpu6050, -3920), 25.0, 0.5 / 340.0);
+  EXPECT_NEAR(mpu::temperature_c(MpuChip::kMpu6500, 1335), 25.0, 0.5 / 333.87);
 }
 
 TEST(HalMockMpu, BurstReadIsBigEndianInRegisterOrder) {
@@ -274,7 +274,7 @@ TEST(HalMockMpu, NackedReadDoesNotClearDataReady) {
 }
 
 TEST(HalMockMpu, AbsentAddressIsNack) {
-  MpuRegisterFile chip(MpuModel::kMpu6050);
+  MpuRegisterFile chip(MpuChip::kMpu6050);
   MockI2cBus bus;
   ASSERT_TRUE(bus.attach(0x68, chip));
   std::uint8_t v = 0xEE;
@@ -290,8 +290,8 @@ TEST(HalMockMpu, AbsentAddressIsNack) {
 }
 
 TEST(HalMockMpu, AttachRejectsDuplicatesAndInvalidAddresses) {
-  MpuRegisterFile a(MpuModel::kMpu6050);
-  MpuRegisterFile b(MpuModel::kMpu6500);
+  MpuRegisterFile a(MpuChip::kMpu6050);
+  MpuRegisterFile b(MpuChip::kMpu6500);
   MockI2cBus bus;
   EXPECT_TRUE(bus.attach(0x68, a));
   EXPECT_FALSE(bus.attach(0x68, b));
@@ -351,7 +351,7 @@ TEST(HalMockMpu, TransferLogRecordsWhatTheDriverAskedFor) {
 }
 
 TEST(HalMockMpu, WrongWhoAmISurvivesResetUntilCleared) {
-  Rig rig(MpuModel::kMpu9250);
+  Rig rig(MpuChip::kMpu9250);
   rig.chip.set_wrong_who_am_i(0x73);
   std::uint8_t v = 0;
   ASSERT_EQ(rig.bus.read_registers(kAddr, mpu::kWhoAmI, &v, 1), HalStatus::kOk);

@@ -17,12 +17,12 @@
 #include "runtime/devices/camera/camera_device.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/pipeline/tick_pipeline.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_robot.hpp"
 #include "support/alloc_counter.hpp"
 #include "runtime/devices/device_layout.hpp"
 #include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
-#include "sim/simulated_drive.hpp"
+#include "sim/sim_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
 #include "support/sim_toml.hpp"
@@ -76,7 +76,7 @@ TEST(SimCamera, LockstepDriveRectifiesEveryFrameAtTheConfiguredRate) {
   ASSERT_TRUE(r.config) << errors(r);
   sim::DriveOptions options;
   options.scenario_path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml";
-  const sim::DriveResult d = sim::run_simulated_drive(*r.config, options, nullptr);
+  const sim::DriveResult d = sim::run_sim_drive(*r.config, options, nullptr);
   ASSERT_TRUE(d.ok) << d.error;
   const DeviceStatus* camera = find_device(d.final, "camera");
   ASSERT_NE(camera, nullptr);
@@ -105,7 +105,7 @@ TEST(SimCamera, RecordedFramesReplayThroughTheDriver) {
   options.scenario_path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml";
   options.record_path = path;
   options.config_text = text;
-  const sim::DriveResult d = sim::run_simulated_drive(*r.config, options, nullptr);
+  const sim::DriveResult d = sim::run_sim_drive(*r.config, options, nullptr);
   ASSERT_TRUE(d.ok) << d.error;
   EXPECT_EQ(d.recording_lost, 0);
   const DeviceStatus* live = find_device(d.final, "camera");
@@ -174,7 +174,7 @@ TEST(SimCamera, PreviewAndCameraInfoOfTheNewestPair) {
   const TimeNs t0 = 1'000'000'000;
   hal::mock::SimClock clock(t0);
   std::string err;
-  auto robot = sim::SimulatedRobot::create(*r.config, std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml",
+  auto robot = sim::SimRobot::create(*r.config, std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml",
                                            clock, t0, &err);
   ASSERT_TRUE(robot) << err;
   NullSink null_sink;
@@ -241,7 +241,7 @@ frame = "nowhere_optical"
   ASSERT_TRUE(r.config) << errors(r);
   sim::DriveOptions options;
   options.scenario_path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml";
-  const sim::DriveResult d = sim::run_simulated_drive(*r.config, options, nullptr);
+  const sim::DriveResult d = sim::run_sim_drive(*r.config, options, nullptr);
   EXPECT_FALSE(d.ok);
   EXPECT_NE(d.error.find("camera.frame 'nowhere_optical' is not connected to 'base_link'"), std::string::npos) << d.error;
 }
@@ -266,7 +266,7 @@ calibration = "calibration/SN999.conf"
   ASSERT_TRUE(r.config) << errors(r);
   sim::DriveOptions options;
   options.scenario_path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/straight.toml";
-  const sim::DriveResult d = sim::run_simulated_drive(*r.config, options, nullptr);
+  const sim::DriveResult d = sim::run_sim_drive(*r.config, options, nullptr);
   EXPECT_FALSE(d.ok);
   EXPECT_NE(d.error.find("SN999.conf"), std::string::npos) << d.error;
 }

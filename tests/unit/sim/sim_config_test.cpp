@@ -10,7 +10,7 @@
 #include "rtfuse/odometry_t.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/fusion/fusion_core.hpp"
-#include "sim/lcm_sim_robot.hpp"
+#include "sim/sim_lcm_robot.hpp"
 
 namespace rtfuse::sim {
 namespace {
@@ -73,7 +73,7 @@ TEST(SimToml, FusedEstimateBeatsRawWheelOdometry) {
   ASSERT_NE(core, nullptr) << error;
 
   const TimeNs start = 500 * kSec;
-  LcmSimRobot robot(cfg.sim, start);
+  SimLcmRobot robot(cfg.sim, start);
   const TimeNs tick = sec_to_ns(1.0 / cfg.rate_hz);
   // Five laps (about three minutes): long enough for wheel odometry's heading
   // to wander well away while the AHRS yaw stays bounded.

@@ -1,8 +1,8 @@
-// run_simulated_drive on config/sim.toml: the real drivers, FusionCore and
+// run_sim_drive on config/sim.toml: the real drivers, FusionCore and
 // Publisher on the bus-level simulated robot, in lockstep. A drive ends
 // where its scenario says, close to the ground truth, says why when the
 // config does not match the robot, and is the same every time.
-#include "sim/simulated_drive.hpp"
+#include "sim/sim_drive.hpp"
 
 #include <unistd.h>
 
@@ -57,7 +57,7 @@ TEST(SimulatedDrive, StraightRunEndsCloseToTheTruth) {
   const RuntimeConfig cfg = load_sim_toml();
   DriveOptions opt;
   opt.scenario_path = kStraight;
-  const DriveResult r = run_simulated_drive(cfg, opt, nullptr);
+  const DriveResult r = run_sim_drive(cfg, opt, nullptr);
   ASSERT_TRUE(r.ok) << r.error;
   std::printf("straight: %lld ticks, %.1f s; fused final %.4f m rms %.4f m yaw %.5f rad; "
               "raw wheels final %.4f m rms %.4f m; raw x %.3f y %.3f\n",
@@ -95,7 +95,7 @@ TEST(SimulatedDrive, NodeIdTheRobotDoesNotHaveIsNamed) {
   const RuntimeConfig cfg = load_sim_toml();
   DriveOptions opt;
   opt.scenario_path = variant_of_straight("node5", {{"left_nodes = [1]", "left_nodes = [5]"}});
-  const DriveResult r = run_simulated_drive(cfg, opt, nullptr);
+  const DriveResult r = run_sim_drive(cfg, opt, nullptr);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.ticks, 0);
   EXPECT_EQ(r.error, kSimToml + ": can.node[0].node_id = 1 is not an encoder of the simulated robot in " +
@@ -107,13 +107,13 @@ TEST(SimulatedDrive, EncoderWidthOrDirectionTheRobotDoesNotHaveIsNamed) {
   const RuntimeConfig cfg = load_sim_toml();  // 32-bit unsigned, counting up
   DriveOptions opt;
   opt.scenario_path = variant_of_straight("bits16", {{"encoder_bits = 32", "encoder_bits = 16"}});
-  DriveResult r = run_simulated_drive(cfg, opt, nullptr);
+  DriveResult r = run_sim_drive(cfg, opt, nullptr);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.error, kSimToml + ": can.node[0] reads a 32-bit unsigned position but the simulated encoder in " +
                          opt.scenario_path + " counts 16-bit unsigned");
   std::remove(opt.scenario_path.c_str());
   opt.scenario_path = variant_of_straight("inverted", {{"[robot]", "[robot]\ninvert_right = true"}});
-  r = run_simulated_drive(cfg, opt, nullptr);
+  r = run_sim_drive(cfg, opt, nullptr);
   EXPECT_FALSE(r.ok);
   EXPECT_EQ(r.error, kSimToml + ": can.node[1].sign = 1 but the simulated encoder in " + opt.scenario_path +
                          " counts down driving forward");
@@ -126,8 +126,8 @@ TEST(SimulatedDrive, SameDriveTwiceIsBitIdentical) {
   // 2 m instead of 10: 2 s stop, 4 s driving, 2 s stop, 1 s more.
   opt.scenario_path =
       variant_of_straight("short", {{"duration_s = 20.0", "duration_s = 9.0"}, {"length_m = 10.0", "length_m = 2.0"}});
-  const DriveResult a = run_simulated_drive(cfg, opt, nullptr);
-  const DriveResult b = run_simulated_drive(cfg, opt, nullptr);
+  const DriveResult a = run_sim_drive(cfg, opt, nullptr);
+  const DriveResult b = run_sim_drive(cfg, opt, nullptr);
   std::remove(opt.scenario_path.c_str());
   ASSERT_TRUE(a.ok) << a.error;
   ASSERT_TRUE(b.ok) << b.error;

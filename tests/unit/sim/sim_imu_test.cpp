@@ -68,7 +68,7 @@ struct Decoded {
   std::uint8_t bytes[14];
 };
 
-Decoded burst_read(SimImu& imu, sim::MpuModel model = sim::MpuModel::kMpu6050) {
+Decoded burst_read(SimImu& imu, sim::MpuChip model = sim::MpuChip::kMpu6050) {
   Decoded d{};
   EXPECT_EQ(imu.read_registers(0x68, mpu::kAccelXoutH, d.bytes, 14), HalStatus::kOk);
   auto be16 = [&](int i) { return static_cast<std::int16_t>((d.bytes[i] << 8) | d.bytes[i + 1]); };
@@ -295,7 +295,7 @@ TEST(SimImu, WaitAndBurstReadDoNotAllocate) {
 
 TEST(SimImu, ModelAndAddressComeFromTheScenario) {
   DriveScenario sc = turning_drive();
-  sc.imu.model = SimImuModel::kMpu9250;
+  sc.imu.model = MpuChip::kMpu9250;
   sc.imu.address = 0x69;
   const TruthTrajectory truth(sc);
   SimClock clock(kT0);

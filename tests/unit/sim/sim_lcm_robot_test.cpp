@@ -1,4 +1,4 @@
-#include "sim/lcm_sim_robot.hpp"
+#include "sim/sim_lcm_robot.hpp"
 
 #include <gtest/gtest.h>
 
@@ -27,7 +27,7 @@ struct Captured {
   TimeNs stamp;
 };
 
-std::vector<Captured> drain(LcmSimRobot& robot, TimeNs until) {
+std::vector<Captured> drain(SimLcmRobot& robot, TimeNs until) {
   std::vector<Captured> out;
   SimMessage m{};
   while (robot.next_due(until, &m)) out.push_back({m.channel, {m.data, m.data + m.size}, m.stamp});
@@ -59,8 +59,8 @@ struct Stats {
   double stddev() const { return std::sqrt(sum_sq / n - mean() * mean()); }
 };
 
-TEST(LcmSimRobot, MessageRatesOverTenSeconds) {
-  LcmSimRobot robot(LcmSimConfig{}, kStart);
+TEST(SimLcmRobot, MessageRatesOverTenSeconds) {
+  SimLcmRobot robot(SimLcmConfig{}, kStart);
   const auto msgs = drain(robot, kStart + 10 * kSec - 1);
   int imu = 0, odom = 0, truth = 0;
   for (const auto& m : msgs) {
@@ -74,8 +74,8 @@ TEST(LcmSimRobot, MessageRatesOverTenSeconds) {
   EXPECT_EQ(imu + odom + truth, static_cast<int>(msgs.size()));
 }
 
-TEST(LcmSimRobot, MessagesComeInTimeOrderWithMatchingHeaders) {
-  LcmSimRobot robot(LcmSimConfig{}, kStart);
+TEST(SimLcmRobot, MessagesComeInTimeOrderWithMatchingHeaders) {
+  SimLcmRobot robot(SimLcmConfig{}, kStart);
   EXPECT_EQ(robot.next_time(), kStart);
   SimMessage m{};
   EXPECT_FALSE(robot.next_due(kStart - 1, &m));  // nothing before its time
@@ -106,9 +106,9 @@ TEST(LcmSimRobot, MessagesComeInTimeOrderWithMatchingHeaders) {
   }
 }
 
-TEST(LcmSimRobot, TruthIsAFigureEightThatClosesAfterOnePeriod) {
-  LcmSimConfig cfg;
-  LcmSimRobot robot(cfg, kStart);
+TEST(SimLcmRobot, TruthIsAFigureEightThatClosesAfterOnePeriod) {
+  SimLcmConfig cfg;
+  SimLcmRobot robot(cfg, kStart);
   const double period = robot.period_s();
   ASSERT_TRUE(std::isfinite(period));
 
@@ -160,9 +160,9 @@ TEST(LcmSimRobot, TruthIsAFigureEightThatClosesAfterOnePeriod) {
   }
 }
 
-TEST(LcmSimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
-  LcmSimConfig cfg;
-  LcmSimRobot robot(cfg, kStart);
+TEST(SimLcmRobot, ImuMatchesTruthPlusBiasWithinNoise) {
+  SimLcmConfig cfg;
+  SimLcmRobot robot(cfg, kStart);
   const SimBiases& bias = robot.biases();
   for (int i = 0; i < 3; ++i) {
     EXPECT_EQ(std::abs(bias.gyro[i]), cfg.gyro_bias_rad_s);
@@ -210,10 +210,10 @@ TEST(LcmSimRobot, ImuMatchesTruthPlusBiasWithinNoise) {
   EXPECT_LT(yaw.stddev(), std::hypot(cfg.orientation_noise_rad, cfg.yaw_error_rad));
 }
 
-TEST(LcmSimRobot, ImuYawErrorStaysBoundedOverALongDrive) {
-  LcmSimConfig cfg;
+TEST(SimLcmRobot, ImuYawErrorStaysBoundedOverALongDrive) {
+  SimLcmConfig cfg;
   cfg.imu_rate_hz = 20.0;  // fewer messages, same error process
-  LcmSimRobot robot(cfg, kStart);
+  SimLcmRobot robot(cfg, kStart);
   Stats yaw;
   double worst = 0.0;
   for (const auto& c : drain(robot, kStart + 1200 * kSec)) {
@@ -229,9 +229,9 @@ TEST(LcmSimRobot, ImuYawErrorStaysBoundedOverALongDrive) {
   EXPECT_LT(worst, 5.5 * sigma);
 }
 
-TEST(LcmSimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
-  LcmSimConfig cfg;
-  LcmSimRobot robot(cfg, kStart);
+TEST(SimLcmRobot, OdometryTwistIsSlippedTruthPlusNoise) {
+  SimLcmConfig cfg;
+  SimLcmRobot robot(cfg, kStart);
   Stats vx, vyaw;
   double slip_min = 1.0, slip_max = -1.0, yaw_error_max = 0.0, final_error = 0.0;
   for (const auto& c : drain(robot, kStart + 20 * kSec - 1)) {
@@ -269,10 +269,10 @@ TEST(LcmSimRobot, OdometryTwistIsSlippedTruthPlusNoise) {
   EXPECT_LT(final_error, 1.0);
 }
 
-TEST(LcmSimRobot, SameSeedGivesIdenticalBytes) {
-  LcmSimConfig cfg;
+TEST(SimLcmRobot, SameSeedGivesIdenticalBytes) {
+  SimLcmConfig cfg;
   cfg.seed = 42;
-  LcmSimRobot a(cfg, kStart), b(cfg, kStart);
+  SimLcmRobot a(cfg, kStart), b(cfg, kStart);
   const auto ma = drain(a, kStart + 5 * kSec);
   // b is drained in a different rhythm: the output must not depend on it.
   std::vector<Captured> mb;
@@ -290,7 +290,7 @@ TEST(LcmSimRobot, SameSeedGivesIdenticalBytes) {
   }
 
   cfg.seed = 43;
-  LcmSimRobot c(cfg, kStart);
+  SimLcmRobot c(cfg, kStart);
   const auto mc = drain(c, kStart + 5 * kSec);
   ASSERT_EQ(mc.size(), ma.size());
   int differing = 0;
@@ -298,8 +298,8 @@ TEST(LcmSimRobot, SameSeedGivesIdenticalBytes) {
   EXPECT_GT(differing, static_cast<int>(ma.size()) / 2);
 }
 
-TEST(LcmSimRobot, NextDueNeverAllocates) {
-  LcmSimRobot robot(LcmSimConfig{}, kStart);
+TEST(SimLcmRobot, NextDueNeverAllocates) {
+  SimLcmRobot robot(SimLcmConfig{}, kStart);
   SimMessage m{};
   TimeNs now = kStart;
   for (; now < kStart + kSec; now += 5'000'000)

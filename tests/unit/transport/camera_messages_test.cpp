@@ -18,8 +18,8 @@
 namespace rtfuse::transport {
 namespace {
 
-StereoCameraModel zed_vga() {
-  StereoCameraModel m;
+StereoCameraInfo zed_vga() {
+  StereoCameraInfo m;
   m.width = 672;
   m.height = 376;
   m.fx = 350.25;
@@ -40,7 +40,7 @@ Msg decode(const EncodedMessage& e) {
   return msg;
 }
 
-void expect_pinhole(const rtfuse::camera_info_t& c, const StereoCameraModel& m, double tx) {
+void expect_pinhole(const rtfuse::camera_info_t& c, const StereoCameraInfo& m, double tx) {
   EXPECT_EQ(c.width, m.width);
   EXPECT_EQ(c.height, m.height);
   EXPECT_EQ(c.distortion_model, "plumb_bob");
@@ -63,7 +63,7 @@ void expect_pinhole(const rtfuse::camera_info_t& c, const StereoCameraModel& m, 
 }
 
 TEST(CameraInfoEncoder, LeftAndRightFollowTheRosStereoConvention) {
-  const StereoCameraModel m = zed_vga();
+  const StereoCameraInfo m = zed_vga();
   std::string error;
   auto enc = CameraInfoEncoder::create(m, &error);
   ASSERT_NE(enc, nullptr) << error;
@@ -80,7 +80,7 @@ TEST(CameraInfoEncoder, LeftAndRightFollowTheRosStereoConvention) {
   EXPECT_EQ(right.header.seq, 0) << "each eye counts its own messages";
   EXPECT_EQ(right.header.frame_id, "zed_right_optical");
   expect_pinhole(right, m, -m.fx * m.baseline_m);
-  // image_geometry's StereoCameraModel: baseline = -P_right[3] / fx.
+  // image_geometry's StereoCameraInfo: baseline = -P_right[3] / fx.
   EXPECT_NEAR(-right.P[3] / right.P[0], 0.1199, 1e-15);
   EXPECT_LT(right.P[3], 0.0);
 
@@ -94,19 +94,19 @@ TEST(CameraInfoEncoder, LeftAndRightFollowTheRosStereoConvention) {
 
 TEST(CameraInfoEncoder, RefusesBadModelsNamingTheValue) {
   struct Case {
-    void (*change)(StereoCameraModel&);
+    void (*change)(StereoCameraInfo&);
     const char* names;
   };
   const Case cases[] = {
-      {[](StereoCameraModel& m) { m.width = 0; }, "width is 0"},
-      {[](StereoCameraModel& m) { m.height = -3; }, "height is -3"},
-      {[](StereoCameraModel& m) { m.fx = std::numeric_limits<double>::quiet_NaN(); }, "fx is nan"},
-      {[](StereoCameraModel& m) { m.fy = -1.0; }, "fy is -1"},
-      {[](StereoCameraModel& m) { m.cx = std::numeric_limits<double>::infinity(); }, "cx is inf"},
-      {[](StereoCameraModel& m) { m.baseline_m = 0.0; }, "baseline_m is 0"},
+      {[](StereoCameraInfo& m) { m.width = 0; }, "width is 0"},
+      {[](StereoCameraInfo& m) { m.height = -3; }, "height is -3"},
+      {[](StereoCameraInfo& m) { m.fx = std::numeric_limits<double>::quiet_NaN(); }, "fx is nan"},
+      {[](StereoCameraInfo& m) { m.fy = -1.0; }, "fy is -1"},
+      {[](StereoCameraInfo& m) { m.cx = std::numeric_limits<double>::infinity(); }, "cx is inf"},
+      {[](StereoCameraInfo& m) { m.baseline_m = 0.0; }, "baseline_m is 0"},
   };
   for (const Case& c : cases) {
-    StereoCameraModel m = zed_vga();
+    StereoCameraInfo m = zed_vga();
     c.change(m);
     std::string error;
     EXPECT_EQ(CameraInfoEncoder::create(m, &error), nullptr) << c.names;

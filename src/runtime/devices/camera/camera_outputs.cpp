@@ -7,7 +7,7 @@ namespace rtfuse {
 std::unique_ptr<CameraOutputs> CameraOutputs::create(FramePool& pool, const drivers::StereoRectification& r,
                                                      const CameraSection& config, std::string* error) {
   std::unique_ptr<CameraOutputs> o(new CameraOutputs(pool, config));
-  transport::StereoCameraModel model;
+  transport::StereoCameraInfo model;
   model.width = pool.width();
   model.height = pool.height();
   model.fx = r.fx;
