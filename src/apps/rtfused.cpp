@@ -19,15 +19,15 @@
 #include <CLI/CLI.hpp>
 
 #include "hal/linux/monotonic_clock.hpp"
-#include "runtime/devices/camera/camera_calibration.hpp"
 #include "runtime/config/config_loader.hpp"
+#include "runtime/devices/device_registry.hpp"
 #include "runtime/devices/linux_hal.hpp"
 #include "runtime/live/loop_timer.hpp"
 #include "runtime/live/realtime.hpp"
 #include "runtime/live/runtime.hpp"
 #include "sim/ground_truth.hpp"
-#include "sim/lcm_sim_robot.hpp"
-#include "sim/simulated_robot.hpp"
+#include "sim/sim_lcm_robot.hpp"
+#include "sim/sim_robot.hpp"
 
 #ifndef RTFUSE_VERSION  // set by src/apps/CMakeLists.txt from project(VERSION)
 #define RTFUSE_VERSION "unknown"
@@ -48,7 +48,7 @@ namespace {
 std::atomic<bool> g_stop{false};
 void on_signal(int) { g_stop.store(true); }
 
-void sim_thread(rtfuse::sim::LcmSimRobot* sim, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
+void sim_thread(rtfuse::sim::SimLcmRobot* sim, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
   rtfuse::name_this_thread("rtfuse-sim");
   rtfuse::sim::SimMessage msg;
   while (run->load(std::memory_order_relaxed)) {
@@ -61,7 +61,7 @@ void sim_thread(rtfuse::sim::LcmSimRobot* sim, rtfuse::transport::LcmNode* lcm, 
 }
 
 // Ground truth of the bus-level simulated robot onto LCM, at 50 Hz.
-void truth_thread(rtfuse::sim::SimulatedRobot* robot, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
+void truth_thread(rtfuse::sim::SimRobot* robot, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
   rtfuse::name_this_thread("rtfuse-sim");
   rtfuse::sim::GroundTruthEncoder encoder;
   rtfuse::TimeNs next = rtfuse::monotonic_now_ns();
@@ -121,13 +121,17 @@ int main(int argc, char** argv) {
   }
   rtfuse::RuntimeConfig cfg = *loaded.config;
   if (!lcm_url.empty()) cfg.lcm_url = lcm_url;
-  if (cfg.hardware.camera.enabled) {
+  // The embedded config's camera is the one of the embedded calibration.
+  if (config_path.empty() && cfg.hardware.camera.enabled) {
+    cfg.hardware.camera.calibration_text = rtfuse::apps::kEmbeddedCameraCalibration;
+  }
+  // The files the devices name are read here, once, so a missing one stops
+  // before anything runs.
+  for (int i = 0; i < rtfuse::device_type_count(); ++i) {
+    const rtfuse::DeviceDescriptor& d = rtfuse::device_type(i);
     std::string why;
-    // The embedded config's camera is the one of the embedded calibration;
-    // any other is read here, once, so a missing file stops before anything runs.
-    if (config_path.empty()) cfg.hardware.camera.calibration_text = rtfuse::apps::kEmbeddedCameraCalibration;
-    if (!rtfuse::resolve_camera_calibration(&cfg.hardware.camera, &why)) {
-      std::fprintf(stderr, "rtfused: camera.calibration: %s\n", why.c_str());
+    if (d.enabled(cfg) && !d.prepare(cfg, &why)) {
+      std::fprintf(stderr, "rtfused: %s\n", why.c_str());
       return 2;
     }
   }
@@ -136,7 +140,7 @@ int main(int argc, char** argv) {
   rtfuse::HalBuses buses;
   std::unique_ptr<rtfuse::LinuxHal> linux_hal;
   rtfuse::hal::MonotonicClock clock;
-  std::unique_ptr<rtfuse::sim::SimulatedRobot> robot;
+  std::unique_ptr<rtfuse::sim::SimRobot> robot;
   if (cfg.hardware.backend == rtfuse::HalBackend::kLinux) {
     linux_hal = rtfuse::LinuxHal::open(cfg, &error);
     if (!linux_hal) {
@@ -152,7 +156,7 @@ int main(int argc, char** argv) {
     // The embedded config's scenario is the embedded demo drive.
     const std::string_view demo = rtfuse::apps::kEmbeddedDemoScenario;
     const bool embedded = config_path.empty();
-    robot = rtfuse::sim::SimulatedRobot::create(cfg, embedded ? "<embedded config/scenarios/demo.toml>" : "",
+    robot = rtfuse::sim::SimRobot::create(cfg, embedded ? "<embedded config/scenarios/demo.toml>" : "",
                                                 clock, rtfuse::monotonic_now_ns(), &error,
                                                 embedded ? &demo : nullptr);
     if (!robot) {
@@ -166,8 +170,8 @@ int main(int argc, char** argv) {
     std::fprintf(stderr, "rtfused: %s\n", error.c_str());
     return 1;
   }
-  std::unique_ptr<rtfuse::sim::LcmSimRobot> sim;
-  if (cfg.sim.enabled) sim = std::make_unique<rtfuse::sim::LcmSimRobot>(cfg.sim, rtfuse::monotonic_now_ns());
+  std::unique_ptr<rtfuse::sim::SimLcmRobot> sim;
+  if (cfg.sim.enabled) sim = std::make_unique<rtfuse::sim::SimLcmRobot>(cfg.sim, rtfuse::monotonic_now_ns());
 
   struct sigaction sa {};
   sa.sa_handler = on_signal;

@@ -27,7 +27,9 @@ class CameraDescriptor final : public DeviceDescriptor {
   // The factory calibration is read once: the driver and the recording then
   // hold the same bytes, and a replay takes them from the recording.
   bool prepare(RuntimeConfig& cfg, std::string* error) const override {
-    return resolve_camera_calibration(&cfg.hardware.camera, error);
+    if (resolve_camera_calibration(&cfg.hardware.camera, error)) return true;
+    *error = "camera.calibration: " + *error;
+    return false;
   }
   void recorded_files(const RuntimeConfig& cfg, std::vector<transport::RecordedFile>* out) const override {
     const CameraSection& c = cfg.hardware.camera;
