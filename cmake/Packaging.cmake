@@ -162,6 +162,10 @@ set(_rtfuse_deb_deps ${RTFUSE_PACKAGE_PROGRAMS} rtfuse_lcmtypes_gen)
 if(TARGET rtfuse_lcmtypes_jar)
   list(APPEND _rtfuse_deb_deps rtfuse_lcmtypes_jar)
 endif()
+# What the package holds, built without packing it (tools/test-cross.sh
+# builds this and the unit tests only).
+add_custom_target(rtfuse_deb_inputs)
+add_dependencies(rtfuse_deb_inputs ${_rtfuse_deb_deps})
 add_custom_target(rtfuse_deb
   COMMAND ${CMAKE_CPACK_COMMAND} -G DEB --config ${CMAKE_BINARY_DIR}/CPackConfig.cmake
   DEPENDS ${_rtfuse_deb_deps}

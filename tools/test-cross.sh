@@ -2,10 +2,11 @@
 # test-cross.sh [ctest args]: the aarch64 stage of the test command.
 #
 # Builds a stand-in Jetson sysroot from Debian 12 arm64 packages
-# (tools/make-sysroot.sh), cross-builds everything including the tests with
-# toolchains/aarch64-jetson-tx2.cmake, runs the unit, integration and system
-# tests under qemu-aarch64 with the sysroot as the loader's root, installs the
-# arm64 package in a clean arm64 root, and shows what the target-ABI check
+# (tools/make-sysroot.sh), cross-builds the programs and the unit tests with
+# toolchains/aarch64-jetson-tx2.cmake, runs the unit tests under qemu-aarch64
+# with the sysroot as the loader's root, replays recordings across the two
+# architectures, installs the arm64 package in a clean arm64 root, and
+# shows what the target-ABI check
 # says about the aarch64 programs. Called by tools/test.sh after the native
 # tests; runs alone after tools/setup-deps.sh.
 set -euo pipefail
@@ -21,13 +22,22 @@ dir="$root/build/aarch64"
 start=$(date +%s)
 # Configured every time (a second or so, nothing rebuilt when unchanged), so a
 # tree made by hand also gets the native programs for the cross-arch test.
+# Line tables only (-g1): backtraces keep their file and line, and the
+# compiler does a third less work than for full debug info. No benchmarks:
+# their aarch64 figures come from tools/bench-emulated.sh, not from CI.
 cmake -S "$root" -B "$dir" -G Ninja \
   -DCMAKE_TOOLCHAIN_FILE="$root/toolchains/aarch64-jetson-tx2.cmake" \
   -DRTFUSE_SYSROOT="$sysroot" \
-  -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g" \
-  -DRTFUSE_BUILD_TESTS=ON -DRTFUSE_EIGEN_NO_MALLOC_CHECK=ON -DRTFUSE_WERROR=ON \
+  -DCMAKE_BUILD_TYPE=RelWithDebInfo "-DCMAKE_CXX_FLAGS_RELWITHDEBINFO=-O2 -g1" \
+  -DRTFUSE_BUILD_TESTS=ON -DRTFUSE_BUILD_BENCH=OFF -DRTFUSE_EIGEN_NO_MALLOC_CHECK=ON -DRTFUSE_WERROR=ON \
   -DRTFUSE_NATIVE_APPS_DIR="$root/build/test/src/apps" >/dev/null
-cmake --build "$dir" -j"$(nproc)"
+# What this stage runs, and only that: the unit tests, and what the package
+# holds (its programs are the ones the cross-architecture replay runs).
+targets=(rtfuse_deb_inputs)
+for layer in core hal drivers geometry vision estimation transport runtime sim apps; do
+  targets+=("rtfuse_unit_$layer")
+done
+cmake --build "$dir" -j"$(nproc)" --target "${targets[@]}"
 echo "test-cross: aarch64 build took $(($(date +%s) - start)) s"
 
 apps=("$dir/src/apps/rtfused" "$dir/src/apps/rtfuse-replay" "$dir/src/apps/rtfuse-sim")
@@ -48,6 +58,14 @@ if "$root/tools/check-target-abi.sh" "${apps[@]}" --glibc 2.27; then
 fi
 
 cd "$dir"
+# What the emulation proves, and only that: the unit tests on the target's
+# instruction set (every layer's arithmetic, the SIMD paths on NEON), the
+# recordings crossing the two architectures both ways (integration_cross_arch,
+# label cross_arch: every output byte-identical), and the arm64 package in a
+# clean arm64 root. The other integration and system tests replay, drive and
+# publish through the same code the unit tests and the cross-architecture
+# replay already run on aarch64; they run natively (tools/test.sh's first
+# stage) and under the sanitizers.
 # Left out here, each run by the native stage:
 # - qemu-user's termios translation has no B921600: the emulator hands the
 #   kernel another rate and the serial backend rightly refuses the port. Not
@@ -58,8 +76,5 @@ cd "$dir"
 #   integration_cross_arch replays a drive with frames across the two
 #   architectures, every rectified pair compared, which is what this stage
 #   is for.
-# - the quarter-hour GNSS drive (integration_gnss_drive: its targets are
-#   the estimator's, the same bits on both architectures): integration_cross_arch
-#   crosses the same config on the 3-minute GNSS loop.
-ctest --output-on-failure -j2 -L 'unit|integration|system|package' \
-  -E '^(HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack|SimCamera\.LockstepDriveRectifiesEveryFrameAtTheConfiguredRate|SimCamera\.RecordedFramesReplayThroughTheDriver|integration_gnss_drive)$' "$@"
+ctest --output-on-failure -j2 -L 'unit|package|cross_arch' \
+  -E '^(HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack|SimCamera\.LockstepDriveRectifiesEveryFrameAtTheConfiguredRate|SimCamera\.RecordedFramesReplayThroughTheDriver)$' "$@"

@@ -27,7 +27,8 @@
 #
 # NAME=VALUE: CPACK (cpack), REPLAY (rtfuse-replay for the local check),
 # LCMTYPES (generated Python types), CACHE (board root cache, default
-# BUILD_DIR/deploy-board).
+# BUILD_DIR/deploy-board), PREPARE_ONLY (1: make the cached root and stop;
+# tools/test.sh does it beside the build).
 #
 # Exit: 0 pass, 1 fail, 77 skipped (not root, or a tool missing).
 set -euo pipefail
@@ -51,10 +52,10 @@ if [[ $# -lt 2 ]]; then
 fi
 build=$(cd "$1" && pwd) out=$2
 shift 2
-CPACK=cpack REPLAY='' LCMTYPES='' CACHE=$build/deploy-board
+CPACK=cpack REPLAY='' LCMTYPES='' CACHE=$build/deploy-board PREPARE_ONLY=0
 for kv in "$@"; do
   case "$kv" in
-    CPACK=* | REPLAY=* | LCMTYPES=* | CACHE=*) printf -v "${kv%%=*}" '%s' "${kv#*=}" ;;
+    CPACK=* | REPLAY=* | LCMTYPES=* | CACHE=* | PREPARE_ONLY=*) printf -v "${kv%%=*}" '%s' "${kv#*=}" ;;
     *) echo "$0: unknown setting '$kv'" >&2; exit 2 ;;
   esac
 done
@@ -69,7 +70,8 @@ since() { awk -v a="$1" -v b="$(now)" 'BEGIN { printf "%.1f", b - a }'; }
 for t in debootstrap systemd-nspawn ip ssh ssh-keygen lcm-logger dpkg-deb chroot mount "$CPACK" /usr/bin/python3; do
   command -v "$t" >/dev/null || skip "$t not found (tools/setup-deps.sh installs it)"
 done
-[[ -f $build/CPackConfig.cmake ]] || fail "$build/CPackConfig.cmake missing: the build tree has no packaging (cmake/Packaging.cmake)"
+[[ $PREPARE_ONLY == 1 || -f $build/CPackConfig.cmake ]] ||
+  fail "$build/CPackConfig.cmake missing: the build tree has no packaging (cmake/Packaging.cmake)"
 
 mkdir -p "$out" "$CACHE"
 out=$(cd "$out" && pwd)
@@ -112,6 +114,11 @@ if [[ ! -f $stamp || $(sed -n 1p "$stamp") != "$INCLUDE" ]]; then
   printf '%s\ndebootstrap %s s\n' "$INCLUDE" "$(since "$t0")" >"$stamp"
 fi
 say "board root $root ($(sed -n 2p "$stamp"), reused when complete)"
+# PREPARE_ONLY=1: only the cached root (tools/test.sh makes it beside the build).
+if [[ $PREPARE_ONLY == 1 ]]; then
+  say "prepared"
+  exit 0
+fi
 
 # --- the package, packed from this build tree -------------------------------
 t0=$(now)

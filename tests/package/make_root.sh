@@ -37,6 +37,11 @@ done
 command -v debootstrap >/dev/null || skip "debootstrap not installed (apt-get install debootstrap)"
 
 marker=$dir/.rtfuse-root-complete
+# One maker at a time per root: tools/test.sh makes the roots beside the
+# build, and a test that starts meanwhile waits here, then reuses it.
+mkdir -p "$(dirname "$dir")"
+exec 8>"$dir.lock"
+flock 8
 if [[ -f $marker ]]; then
   note "reusing the $arch root $dir ($(cat "$marker"))"
   echo "root-seconds 0"
