@@ -23,6 +23,12 @@ enum class HalBackend : std::uint8_t { kNone, kLinux, kSim };
 // [[sensor]] sources the registered devices offer (devices/device_registry).
 constexpr int kMaxDeviceSources = 8;
 
+constexpr std::array<int, kMaxDeviceSources> no_source_sensors() noexcept {
+  std::array<int, kMaxDeviceSources> a{};
+  for (int& s : a) s = -1;
+  return a;
+}
+
 struct HardwareConfig {
   HalBackend backend = HalBackend::kNone;
   std::string scenario;  // backend "sim": the drive scenario file (resolved path)
@@ -34,7 +40,7 @@ struct HardwareConfig {
   VoSection vo;
   GnssSection gnss;
   // Per device source (device_source(id)): the [[sensor]] it feeds, -1 none.
-  std::array<int, kMaxDeviceSources> source_sensor = {-1, -1, -1, -1, -1, -1, -1, -1};
+  std::array<int, kMaxDeviceSources> source_sensor = no_source_sensors();
 };
 
 }  // namespace rtfuse

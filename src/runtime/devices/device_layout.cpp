@@ -5,8 +5,6 @@
 
 namespace rtfuse {
 
-static_assert(kMaxDeviceTypes == 8, "DeviceLayout::first_slot's initialiser has one -1 per registered device");
-
 DeviceLayout device_layout(const RuntimeConfig& cfg) noexcept {
   DeviceLayout l;
   for (int i = 0; i < device_type_count(); ++i) {

@@ -12,7 +12,10 @@ namespace rtfuse {
 // The first slot of each registered device (-1: not enabled) and the count
 // of device slots (the navsat transforms' first slot).
 struct DeviceLayout {
-  int first_slot[kMaxDeviceTypes] = {-1, -1, -1, -1, -1, -1, -1, -1};
+  DeviceLayout() noexcept {
+    for (int& s : first_slot) s = -1;
+  }
+  int first_slot[kMaxDeviceTypes];
   int device_slots = 0;
 };
 
