@@ -34,7 +34,7 @@ class NullSink final : public MessageSink {
 
 // A consumer on a thread of its own that needs far longer per pair than the
 // camera's period (a mapper on a slow core): it takes the newest waiting
-// pair, checks it is whole, and sleeps.
+// pair, checks it is whole, and holds it while the camera goes on.
 class SlowConsumer final : public FrameConsumer {
  public:
   explicit SlowConsumer(FramePool& pool) : pool_(pool) {}
@@ -59,7 +59,13 @@ class SlowConsumer final : public FrameConsumer {
         for (int y = 0; y < f.height; ++y) sum += f.left[static_cast<std::size_t>(y) * f.stride + f.width / 2];
         if (f.frame_id <= last_id_ || f.width <= 0 || sum == 0) bad_.fetch_add(1);
         last_id_ = f.frame_id;
-        std::this_thread::sleep_for(std::chrono::milliseconds(40));
+        // Slower than the camera whatever either's speed (a sanitizer, a
+        // loaded machine): it works until three more pairs were offered.
+        const std::int64_t until = mailbox_.offered() + 3;
+        const auto give_up = std::chrono::steady_clock::now() + std::chrono::seconds(5);
+        while (running_.load() && mailbox_.offered() < until && std::chrono::steady_clock::now() < give_up) {
+          std::this_thread::sleep_for(std::chrono::milliseconds(1));
+        }
         pool_.release(h);
         taken_.fetch_add(1);
       }
