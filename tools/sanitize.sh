@@ -1,6 +1,7 @@
 #!/usr/bin/env bash
 # sanitize.sh asan|tsan [test args...]: build a sanitizer tree under build/
-# and run what it checks (issue 11):
+# and run what it checks (issue 11); sanitize.sh build asan|tsan only builds
+# it (tools/test.sh builds the trees while earlier stages test):
 #   asan  AddressSanitizer + UndefinedBehaviorSanitizer (clang, -O1 -g1, no
 #         recovery: any finding fails its test): the unit and integration
 #         tests, in the tree that also holds the fuzz harnesses
@@ -25,10 +26,23 @@ configure_tsan() {  # dir
 }
 
 supp="$root/tests/sanitizers"
+build_tsan() {
+  dir="$root/build/tsan"
+  configure_tsan "$dir"
+  cmake --build "$dir" -j"$(nproc)" --target rtfuse_unit_core rtfuse_unit_runtime rtfused
+}
+# shellcheck source=asan_tree.sh
+source "$root/tools/asan_tree.sh"
+if [[ $kind == build ]]; then
+  case "${1:-}" in
+    asan) configure_asan_tree; cmake --build "$asan_tree" -j"$(nproc)" ;;
+    tsan) build_tsan ;;
+    *) echo "usage: sanitize.sh build asan|tsan" >&2; exit 2 ;;
+  esac
+  exit 0
+fi
 case "$kind" in
   asan)
-    # shellcheck source=asan_tree.sh
-    source "$root/tools/asan_tree.sh"
     configure_asan_tree
     dir="$asan_tree"
     cmake --build "$dir" -j"$(nproc)"
@@ -41,9 +55,7 @@ case "$kind" in
     (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference -E '^integration_gnss_drive$' "$@")
     ;;
   tsan)
-    dir="$root/build/tsan"
-    configure_tsan "$dir"
-    cmake --build "$dir" -j"$(nproc)" --target rtfuse_unit_core rtfuse_unit_runtime rtfused
+    build_tsan
     export TSAN_OPTIONS="suppressions=$supp/tsan.supp:halt_on_error=1:second_deadlock_stack=1"
     "$dir/tests/rtfuse_unit_core" "$@"
     "$dir/tests/rtfuse_unit_runtime" "$@"

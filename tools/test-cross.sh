@@ -13,6 +13,13 @@ set -euo pipefail
 root=$(cd "$(dirname "$0")/.." && pwd)
 sysroot="$root/build/sysroot-arm64"
 dir="$root/build/aarch64"
+# --build-only: the sysroot and the aarch64 tree, no tests (tools/test.sh
+# builds it while earlier stages test).
+build_only=0
+if [[ ${1:-} == --build-only ]]; then
+  build_only=1
+  shift
+fi
 
 "$root/tools/make-sysroot.sh" "$sysroot"
 # The native programs, for the cross-architecture replay test (a no-op after
@@ -39,6 +46,7 @@ for layer in core hal drivers geometry vision estimation transport runtime sim a
 done
 cmake --build "$dir" -j"$(nproc)" --target "${targets[@]}"
 echo "test-cross: aarch64 build took $(($(date +%s) - start)) s"
+((build_only)) && exit 0
 
 apps=("$dir/src/apps/rtfused" "$dir/src/apps/rtfuse-replay" "$dir/src/apps/rtfuse-sim")
 

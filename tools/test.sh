@@ -35,12 +35,49 @@ warm_start=$SECONDS
 wait "$warm" || true
 cat "$root/build/warm-caches.log" >&2
 echo "test.sh: stage 'waiting for tools/warm-caches.sh' took $((SECONDS - warm_start)) s" >&2
+
+# The later stages' trees (ASan with the fuzz harnesses, TSan, aarch64)
+# compile one after the other at the lowest priority while the tests run:
+# a test's process still gets the CPU it asks for (nice 19 against 0 is
+# about 1.5 % to 98.5 %), a build takes what the tests leave idle (their
+# waits, a live run's sleeps, a board booting). Each stage waits for its
+# tree, then builds it again in the foreground, which is a no-op unless the
+# background build failed: then the foreground shows why.
+sanitizers=1
+[[ "${RTFUSE_SANITIZERS:-1}" != 0 ]] || sanitizers=0
+prebuilt=$root/build/prebuilt
+rm -rf "$prebuilt"
+mkdir -p "$prebuilt"
+# Its own process group (job control), so a failing stage can stop it whole.
+set -m
+(
+  if ((sanitizers)); then
+    nice -n 19 "$root/tools/sanitize.sh" build asan >"$prebuilt/asan.log" 2>&1; echo $? >"$prebuilt/asan"
+    nice -n 19 "$root/tools/sanitize.sh" build tsan >"$prebuilt/tsan.log" 2>&1; echo $? >"$prebuilt/tsan"
+  fi
+  if ((cross)); then
+    nice -n 19 "$root/tools/test-cross.sh" --build-only >"$prebuilt/aarch64.log" 2>&1; echo $? >"$prebuilt/aarch64"
+  fi
+) &
+prebuild=$!
+set +m
+# Stops the background builds, compilers included, when a stage fails.
+trap 'kill -- -"$prebuild" 2>/dev/null || true' EXIT
+wait_for_tree() {  # name: until the background build of that tree ended
+  local start=$SECONDS
+  while [[ ! -f "$prebuilt/$1" ]] && kill -0 "$prebuild" 2>/dev/null; do sleep 2; done
+  echo "test.sh: waited $((SECONDS - start)) s for the background build of the $1 tree (exit $(cat "$prebuilt/$1" 2>/dev/null || echo none))" >&2
+}
+
 (cd "$root/build/test" && stage ctest --output-on-failure -j2 "$@")
-if [[ "${RTFUSE_SANITIZERS:-1}" != 0 ]]; then
+if ((sanitizers)); then
+  wait_for_tree asan
   stage "$root/tools/sanitize.sh" asan "$@"
   stage "$root/tools/fuzz.sh" --regression
+  wait_for_tree tsan
   stage "$root/tools/sanitize.sh" tsan
 fi
 if ((cross)); then
+  wait_for_tree aarch64
   stage "$root/tools/test-cross.sh" "$@"
 fi

@@ -20,7 +20,7 @@ cross=1
 stage() {
   local start=$SECONDS rc=0
   "$@" || rc=$?
-  echo "warm-caches: '$*' took $((SECONDS - start)) s$( ((rc == 0)) || echo " and failed (exit $rc): the test makes it itself")"
+  echo >&2 "warm-caches: '$*' took $((SECONDS - start)) s$( ((rc == 0)) || echo " and failed (exit $rc): the test makes it itself")"
 }
 # The paths the tests use: tests/package/CMakeLists.txt (RTFUSE_PACKAGE_ROOTS,
 # per tree) and tests/deploy/run_deploy_test.sh (CACHE, per tree).
