@@ -13,7 +13,7 @@
 #include "apps/canvas.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace bitmap_font_test {
 
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kInk{10, 20, 30};
@@ -165,5 +165,5 @@ TEST(BitmapFont, TextIsClippedToTheCanvasAndTheClip) {
   EXPECT_EQ(c.x1, 19);  // the crossbar of the fourth
 }
 
-}  // namespace
+}  // namespace bitmap_font_test
 }  // namespace rtfuse::apps

@@ -15,7 +15,7 @@
 #include "unit/apps/png_readback.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace canvas_test {
 
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kBlue{20, 60, 200};
@@ -124,5 +124,5 @@ TEST(Canvas, UnwritablePathNamesThePathAndErrno) {
   EXPECT_EQ(::stat("/dev/full", &st), 0) << "a device is never unlinked";
 }
 
-}  // namespace
+}  // namespace canvas_test
 }  // namespace rtfuse::apps

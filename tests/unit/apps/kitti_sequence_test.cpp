@@ -9,7 +9,7 @@
 #include "apps/trajectory_metrics.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace kitti_sequence_test {
 
 const std::string kP0 = "7.070912e+02 0.000000e+00 6.018873e+02 0.000000e+00 0.000000e+00 7.070912e+02 "
                         "1.831104e+02 0.000000e+00 0.000000e+00 0.000000e+00 1.000000e+00 0.000000e+00";
@@ -112,5 +112,5 @@ TEST(TrajectoryErrors, ReanchoredJudgesAStretchAsIfItStartedThere) {
   EXPECT_TRUE(reanchored(est, 11).empty());
 }
 
-}  // namespace
+}  // namespace kitti_sequence_test
 }  // namespace rtfuse::apps

@@ -9,7 +9,7 @@
 #include "apps/error_panel.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace legend_test {
 
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kBlack{0, 0, 0};
@@ -83,5 +83,5 @@ TEST(ErrorPanel, LegendStatesTheRms) {
   EXPECT_EQ(error_series_label(s), "visual odometry (dashed: RMS 0.141 m)");
 }
 
-}  // namespace
+}  // namespace legend_test
 }  // namespace rtfuse::apps

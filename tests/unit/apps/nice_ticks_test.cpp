@@ -9,7 +9,7 @@
 #include <limits>
 
 namespace rtfuse::apps {
-namespace {
+namespace nice_ticks_test {
 
 // The mantissa of a 1-2-5 step: 1, 2 or 5 (to rounding).
 double mantissa(double step) { return step / std::pow(10.0, std::floor(std::log10(step) + 1e-9)); }
@@ -88,5 +88,5 @@ TEST(NiceTicks, LabelsCarryTheStepsDecimals) {
   EXPECT_EQ(tick_label(1000.0, 200.0), "1000");
 }
 
-}  // namespace
+}  // namespace nice_ticks_test
 }  // namespace rtfuse::apps

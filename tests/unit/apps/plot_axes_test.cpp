@@ -16,7 +16,7 @@
 #include "apps/nice_ticks.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace plot_axes_test {
 
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kRed{200, 0, 0};
@@ -152,5 +152,5 @@ TEST(PlotAxes, DataStaysInsideTheFrame) {
   EXPECT_EQ(canvas.clip().w, 300) << "the canvas' clip is restored";
 }
 
-}  // namespace
+}  // namespace plot_axes_test
 }  // namespace rtfuse::apps

@@ -18,7 +18,7 @@
 #include "vision/stereo_odometry.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace stereo_odometry_kitti_test {
 
 const std::string kSeq = std::string(RTFUSE_SHARED_DATA) + "/kitti/kitti06_0000_0050";
 
@@ -125,5 +125,5 @@ TEST(StereoOdometryKitti, UnusableFramesAreSaidSo) {
   EXPECT_EQ(vo.process(flash, flash, 3).status, vision::VoStatus::kTooFewMatches);
 }
 
-}  // namespace
+}  // namespace stereo_odometry_kitti_test
 }  // namespace rtfuse::apps

@@ -16,7 +16,7 @@
 #include "unit/apps/png_readback.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace stereo_png_test {
 
 using test_png::read_rgb_png;
 using test_png::RgbImage;
@@ -189,5 +189,5 @@ TEST(StereoPng, HeaderedWriteErrorNamesThePathAndErrno) {
   EXPECT_NE(error.find("No such file or directory"), std::string::npos) << error;
 }
 
-}  // namespace
+}  // namespace stereo_png_test
 }  // namespace rtfuse::apps

@@ -17,7 +17,7 @@
 #include "unit/apps/png_readback.hpp"
 
 namespace rtfuse::apps {
-namespace {
+namespace trajectory_plot_test {
 
 using test_png::read_rgb_png;
 using test_png::RgbImage;
@@ -176,5 +176,5 @@ TEST(TrajectoryPlot, UnwritablePathNamesThePathAndErrno) {
   EXPECT_NE(error.find("No such file or directory"), std::string::npos) << error;
 }
 
-}  // namespace
+}  // namespace trajectory_plot_test
 }  // namespace rtfuse::apps

@@ -9,7 +9,7 @@
 #include <new>
 
 namespace rtfuse::test {
-namespace {
+namespace alloc_counter_test {
 
 struct alignas(64) Wide {
   char bytes[64];
@@ -75,5 +75,5 @@ TEST(AllocCounter, AScopeCountsOnlyWhileArmed) {
   EXPECT_EQ(inside, 1u);
 }
 
-}  // namespace
+}  // namespace alloc_counter_test
 }  // namespace rtfuse::test

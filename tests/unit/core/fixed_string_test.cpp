@@ -5,7 +5,7 @@
 #include <string>
 #include <type_traits>
 
-namespace {
+namespace fixed_string_test {
 
 using Name = rtfuse::FixedString<8>;
 
@@ -51,4 +51,4 @@ TEST(CoreFixedString, ComparesWithLiteralsViewsAndStrings) {
   EXPECT_FALSE(n == Name("odo"));
 }
 
-}  // namespace
+}  // namespace fixed_string_test

@@ -10,7 +10,7 @@
 #include <thread>
 
 namespace rtfuse {
-namespace {
+namespace frame_mailbox_test {
 
 // Publishes one frame and returns a handle the caller holds, as a source
 // does around on_pair().
@@ -108,5 +108,5 @@ TEST(FrameMailbox, ASlowConsumerNeverStarvesTheProducer) {
   EXPECT_EQ(pool.busy(), 1);
 }
 
-}  // namespace
+}  // namespace frame_mailbox_test
 }  // namespace rtfuse

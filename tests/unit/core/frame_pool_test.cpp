@@ -11,7 +11,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace frame_pool_test {
 
 using rtfuse::FramePool;
 
@@ -221,4 +221,4 @@ TEST(CoreFramePool, StressTwoConsumersFullPoolNoAllocationOnTheProducer) {
   EXPECT_EQ(pool.busy(), 1);
 }
 
-}  // namespace
+}  // namespace frame_pool_test

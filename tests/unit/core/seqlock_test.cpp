@@ -12,7 +12,7 @@ namespace rtfuse::test {
 std::uint64_t allocation_count() noexcept;
 }
 
-namespace {
+namespace seqlock_test {
 
 using rtfuse::SeqLock;
 
@@ -172,4 +172,4 @@ TEST(CoreSeqLock, ConcurrentReadersNeverSeeTornValues) {
   EXPECT_EQ(final_value.words[kStampedWords - 1], writes);
 }
 
-}  // namespace
+}  // namespace seqlock_test

@@ -9,7 +9,7 @@ namespace rtfuse::test {
 std::uint64_t allocation_count() noexcept;
 }
 
-namespace {
+namespace spsc_ring_test {
 
 using rtfuse::SpscRing;
 
@@ -190,4 +190,4 @@ TEST(CoreSpscRing, TwoThreadsPeekPopMultiWordPayload) {
   EXPECT_EQ(bad, 0U);
 }
 
-}  // namespace
+}  // namespace spsc_ring_test

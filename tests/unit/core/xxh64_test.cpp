@@ -10,7 +10,7 @@
 #include <vector>
 
 namespace rtfuse {
-namespace {
+namespace xxh64_test {
 
 std::vector<std::uint8_t> pattern(std::size_t n) {
   std::vector<std::uint8_t> v(n);
@@ -57,5 +57,5 @@ TEST(Xxh64, EveryByteAndTheSeedCount) {
   EXPECT_EQ(h.digest(), base);
 }
 
-}  // namespace
+}  // namespace xxh64_test
 }  // namespace rtfuse

@@ -8,7 +8,7 @@
 
 #include "drivers/imu/attitude_filter.hpp"
 
-namespace {
+namespace attitude_covariance_test {
 
 using rtfuse::drivers::AttitudeAlgorithm;
 using rtfuse::drivers::AttitudeConfig;
@@ -176,4 +176,4 @@ TEST(AttitudeCovariance, InflateAddsOutsideUncertainty) {
   EXPECT_NEAR(f.roll_pitch_variance() - rp, 0.01, 1e-15);
 }
 
-}  // namespace
+}  // namespace attitude_covariance_test

@@ -8,7 +8,7 @@
 #include "drivers/imu/attitude_filter.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace attitude_filter_test {
 
 using rtfuse::drivers::AttitudeAlgorithm;
 using rtfuse::drivers::AttitudeConfig;
@@ -310,4 +310,4 @@ TEST(AttitudeStillness, GapsAndSaturatedAccelerometersRestartTheWindow) {
   EXPECT_FALSE(f.stillness().learnt());
 }
 
-}  // namespace
+}  // namespace attitude_filter_test

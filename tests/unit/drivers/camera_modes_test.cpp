@@ -6,7 +6,7 @@
 
 #include <string>
 
-namespace {
+namespace camera_modes_test {
 
 using rtfuse::drivers::CameraMode;
 using rtfuse::drivers::ZedResolution;
@@ -84,4 +84,4 @@ TEST(CameraModes, SideBySideFrameIsTwoEyesWide) {
   EXPECT_EQ(rtfuse::drivers::yuyv_frame_bytes(m, 2752), 2752u * 376u);  // padded lines
 }
 
-}  // namespace
+}  // namespace camera_modes_test

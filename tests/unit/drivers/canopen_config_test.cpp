@@ -5,7 +5,7 @@
 
 #include "drivers/canopen/canopen_encoders_config.hpp"
 
-namespace {
+namespace canopen_config_test {
 
 using rtfuse::drivers::CanopenEncodersConfig;
 using rtfuse::drivers::effective_tpdo_cob_id;
@@ -103,4 +103,4 @@ TEST(CanopenConfig, StuckMinCountsIsFreeWhenStuckDetectionIsOff) {
   EXPECT_TRUE(validate_config(c, nullptr));
 }
 
-}  // namespace
+}  // namespace canopen_config_test

@@ -12,7 +12,7 @@
 #include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 
-namespace {
+namespace canopen_encoders_test {
 
 using rtfuse::TimeNs;
 using rtfuse::drivers::CanopenEncoders;
@@ -371,4 +371,4 @@ TEST(CanopenEncoders, PollDrainsAtMostTheConfiguredNumberOfFrames) {
   EXPECT_EQ(rig.enc->bus_stats().unexpected_cob_ids, 50);
 }
 
-}  // namespace
+}  // namespace canopen_encoders_test

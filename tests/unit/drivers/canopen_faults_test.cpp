@@ -11,7 +11,7 @@
 #include "hal/mock/mock_can_bus.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace canopen_faults_test {
 
 using rtfuse::TimeNs;
 using rtfuse::drivers::CanopenEncoders;
@@ -472,4 +472,4 @@ TEST(CanopenFaults, PollDoesNotAllocateThroughFaultsAndRecoveries) {
   EXPECT_EQ(rig.enc->bus_stats().bus_off_events, 1);
 }
 
-}  // namespace
+}  // namespace canopen_faults_test

@@ -4,7 +4,7 @@
 
 #include "drivers/canopen/position_unwrap.hpp"
 
-namespace {
+namespace canopen_unwrap_test {
 
 using rtfuse::drivers::position_from_raw;
 using rtfuse::drivers::read_le;
@@ -47,4 +47,4 @@ TEST(CanopenUnwrap, DeltaTakesTheShortestWayAcrossTheWrap) {
   EXPECT_EQ(wrapped_delta(0x1005, 0x20FA, 8), 11);
 }
 
-}  // namespace
+}  // namespace canopen_unwrap_test

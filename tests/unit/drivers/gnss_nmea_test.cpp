@@ -16,7 +16,7 @@
 #include "support/gnss_bytes.hpp"
 
 namespace rtfuse::drivers {
-namespace {
+namespace gnss_nmea_test {
 
 const char* kGga = "$GPGGA,123519,4807.038,N,01131.000,E,1,08,0.9,545.4,M,46.9,M,,*47\r\n";
 const char* kRmc = "$GPRMC,123519,A,4807.038,N,01131.000,E,022.4,084.4,230394,003.1,W*6A\r\n";
@@ -282,5 +282,5 @@ TEST(NmeaFixAssembler, NothingIsAllocatedPerByte) {
   EXPECT_EQ(fixes, 20);
 }
 
-}  // namespace
+}  // namespace gnss_nmea_test
 }  // namespace rtfuse::drivers

@@ -15,7 +15,7 @@
 #include "support/gnss_bytes.hpp"
 
 namespace rtfuse::drivers {
-namespace {
+namespace gnss_receiver_test {
 
 constexpr TimeNs kMs = 1'000'000;
 
@@ -160,5 +160,5 @@ TEST(GnssReceiver, PollAllocatesNothing) {
   EXPECT_EQ(fixes, 20);
 }
 
-}  // namespace
+}  // namespace gnss_receiver_test
 }  // namespace rtfuse::drivers

@@ -15,7 +15,7 @@
 #include "support/gnss_bytes.hpp"
 
 namespace rtfuse::drivers {
-namespace {
+namespace gnss_ubx_test {
 
 using Bytes = std::vector<std::uint8_t>;
 
@@ -231,5 +231,5 @@ TEST(UbxFramer, NothingIsAllocatedPerByte) {
   EXPECT_EQ(fixes, 50);
 }
 
-}  // namespace
+}  // namespace gnss_ubx_test
 }  // namespace rtfuse::drivers

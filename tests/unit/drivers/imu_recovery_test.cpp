@@ -11,7 +11,7 @@
 #include "hal/mock/scripted_gpio.hpp"
 #include "hal/mock/sim_clock.hpp"
 
-namespace {
+namespace imu_recovery_test {
 
 using rtfuse::TimeNs;
 using rtfuse::drivers::ImuMeasurement;
@@ -166,4 +166,4 @@ TEST(MpuImuRecovery, FallingEdgesAreIgnored) {
   EXPECT_EQ(rig.sample(), StepResult::kSample);
 }
 
-}  // namespace
+}  // namespace imu_recovery_test

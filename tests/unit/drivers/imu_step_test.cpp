@@ -12,7 +12,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace imu_step_test {
 
 using rtfuse::TimeNs;
 using rtfuse::drivers::ImuMeasurement;
@@ -406,4 +406,4 @@ TEST(MpuImuStillness, DisabledTheZBiasStaysInTheRate) {
   EXPECT_GT(r.rate_var_end, kGyroNoise * kGyroNoise + 7.6e-3);
 }
 
-}  // namespace
+}  // namespace imu_step_test

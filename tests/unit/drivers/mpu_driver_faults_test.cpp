@@ -10,7 +10,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace mpu_driver_faults_test {
 
 using rtfuse::drivers::ImuReading;
 using rtfuse::drivers::MpuConfig;
@@ -233,4 +233,4 @@ TEST(MpuDriverRealtime, ReadDoesNotAllocate) {
   EXPECT_EQ(rig.driver.stats().good_reads, 500);
 }
 
-}  // namespace
+}  // namespace mpu_driver_faults_test

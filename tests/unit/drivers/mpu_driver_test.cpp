@@ -10,7 +10,7 @@
 #include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/sim_clock.hpp"
 
-namespace {
+namespace mpu_driver_test {
 
 using rtfuse::drivers::ImuReading;
 using rtfuse::drivers::MpuConfig;
@@ -290,4 +290,4 @@ INSTANTIATE_TEST_SUITE_P(Models, MpuDriverTemperature,
                                            TempCase{Chip::kMpu6500, 21.0 + 1335.0 / 333.87, 1335},
                                            TempCase{Chip::kMpu9250, 21.0 - 6677.0 / 333.87, -6677}));
 
-}  // namespace
+}  // namespace mpu_driver_test

@@ -23,7 +23,7 @@
 #include "support/alloc_counter.hpp"
 #include "unit/drivers/zed_test_calibrations.hpp"
 
-namespace {
+namespace stereo_camera_test {
 
 using rtfuse::FramePool;
 using rtfuse::TimeNs;
@@ -531,4 +531,4 @@ TEST(ZedUsbHint, WithoutAnOfferListTheGivenFormatDecides) {
   EXPECT_FALSE(drivers::looks_like_usb2(mode("FHD", 30), given, ""));
 }
 
-}  // namespace
+}  // namespace stereo_camera_test

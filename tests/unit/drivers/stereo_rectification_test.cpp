@@ -16,7 +16,7 @@
 #include "support/alloc_counter.hpp"
 #include "unit/drivers/zed_test_calibrations.hpp"
 
-namespace {
+namespace stereo_rectification_test {
 
 using rtfuse::drivers::CameraIntrinsics;
 using rtfuse::drivers::RawPositionMap;
@@ -201,4 +201,4 @@ TEST(StereoRectification, RawPositionLookupDoesNotAllocate) {
   EXPECT_GT(sum, 0);
 }
 
-}  // namespace
+}  // namespace stereo_rectification_test

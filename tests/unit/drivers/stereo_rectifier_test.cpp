@@ -15,7 +15,7 @@
 #include "support/alloc_counter.hpp"
 #include "unit/drivers/zed_test_calibrations.hpp"
 
-namespace {
+namespace stereo_rectifier_test {
 
 using rtfuse::drivers::GreyImageView;
 using rtfuse::drivers::StereoCalibration;
@@ -321,4 +321,4 @@ TEST(StereoRectifier, NoAllocationPerFrame) {
   EXPECT_EQ(scope.count(), 0u);
 }
 
-}  // namespace
+}  // namespace stereo_rectifier_test

@@ -11,7 +11,7 @@
 #include "drivers/imu/stillness_bias.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace stillness_bias_test {
 
 using rtfuse::drivers::StillnessBiasEstimator;
 using rtfuse::drivers::StillnessConfig;
@@ -208,4 +208,4 @@ TEST(StillnessBias, UpdateDoesNotAllocate) {
   EXPECT_GT(e.stats().blocks_learnt, 0);
 }
 
-}  // namespace
+}  // namespace stillness_bias_test

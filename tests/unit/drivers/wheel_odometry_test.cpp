@@ -13,7 +13,7 @@
 #include "hal/mock/mock_can_bus.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace wheel_odometry_test {
 
 using rtfuse::TimeNs;
 using rtfuse::drivers::DriveKinematics;
@@ -505,4 +505,4 @@ TEST(WheelOdometry, FromCanopenNodesToAPose) {
   EXPECT_LT(std::fabs(odo->pose().y), expect_x * one_count_yaw);
 }
 
-}  // namespace
+}  // namespace wheel_odometry_test

@@ -15,7 +15,7 @@
 
 #include "unit/drivers/zed_test_calibrations.hpp"
 
-namespace {
+namespace zed_calibration_test {
 
 using rtfuse::drivers::ZedCalibration;
 using rtfuse::drivers::ZedResolution;
@@ -323,4 +323,4 @@ TEST(ZedCalibration, SurvivesMutatedInput) {
   EXPECT_GT(parsed, 0);  // edits in skipped sections or values still parse
 }
 
-}  // namespace
+}  // namespace zed_calibration_test

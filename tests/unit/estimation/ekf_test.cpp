@@ -15,7 +15,7 @@
 #include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::est {
-namespace {
+namespace ekf_test {
 
 Measurement measure(UpdateMask mask, const StateVector& z, double variance) {
   Measurement m;
@@ -363,5 +363,5 @@ TEST(Ekf, PredictAndCorrectDoNotAllocate) {
   EXPECT_EQ(scope.count(), 0u);
 }
 
-}  // namespace
+}  // namespace ekf_test
 }  // namespace rtfuse::est

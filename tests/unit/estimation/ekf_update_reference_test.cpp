@@ -16,7 +16,7 @@
 #include "support/random_fusion_subset.hpp"
 
 namespace rtfuse::est {
-namespace {
+namespace ekf_update_reference_test {
 
 using MatL = Eigen::Matrix<long double, Eigen::Dynamic, Eigen::Dynamic>;
 using VecL = Eigen::Matrix<long double, Eigen::Dynamic, 1>;
@@ -179,5 +179,5 @@ TEST(EkfUpdateReference, UpdateThatWouldMakeAVarianceNegativeIsRejected) {
   }
 }
 
-}  // namespace
+}  // namespace ekf_update_reference_test
 }  // namespace rtfuse::est

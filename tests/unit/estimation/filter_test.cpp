@@ -11,7 +11,7 @@
 #include "geometry/rotation.hpp"
 
 namespace rtfuse::est {
-namespace {
+namespace filter_test {
 
 FilterParams params() {
   FilterParams p;
@@ -339,5 +339,5 @@ TEST(SensorModel, RejectionThresholdsFollowThePart) {
   EXPECT_EQ(out.items[2].mahalanobis_threshold, 3.0);
 }
 
-}  // namespace
+}  // namespace filter_test
 }  // namespace rtfuse::est

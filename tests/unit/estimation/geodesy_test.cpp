@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 namespace rtfuse::est {
-namespace {
+namespace geodesy_test {
 
 constexpr double kA = 6378137.0;
 constexpr double kB = 6356752.314245179;  // WGS-84 semi-minor axis
@@ -95,5 +95,5 @@ TEST(LocalTangentPlane, ReverseUndoesForwardKilometresAway) {
   }
 }
 
-}  // namespace
+}  // namespace geodesy_test
 }  // namespace rtfuse::est

@@ -12,7 +12,7 @@
 #include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::est {
-namespace {
+namespace navsat_transform_test {
 
 constexpr double kPi = 3.14159265358979323846;
 const GeodeticPosition kDatum{52.5163, 13.3777, 34.0};
@@ -300,5 +300,5 @@ TEST(NavsatParams, ValidationNamesTheKey) {
   EXPECT_NE(std::string(validate(p)).find("unknown covariance"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace navsat_transform_test
 }  // namespace rtfuse::est

@@ -4,7 +4,7 @@
 
 #include <cmath>
 
-namespace {
+namespace angles_test {
 
 using rtfuse::geometry::kPi;
 using rtfuse::geometry::kTwoPi;
@@ -60,4 +60,4 @@ TEST(GeometryWrapAngle, SameDirectionAndInRangeOverASweep) {
   }
 }
 
-}  // namespace
+}  // namespace angles_test

@@ -12,7 +12,7 @@ namespace rtfuse::test {
 std::uint64_t allocation_count() noexcept;
 }
 
-namespace {
+namespace frame_tree_test {
 
 using rtfuse::geometry::FrameTree;
 using rtfuse::geometry::kPi;
@@ -268,4 +268,4 @@ TEST_F(GeometryFrameTreeErrors, FullTreeStillJoinsKnownFrames) {
   ASSERT_TRUE(tree.lookup("f0", "f1"));
 }
 
-}  // namespace
+}  // namespace frame_tree_test

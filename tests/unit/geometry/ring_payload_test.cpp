@@ -12,7 +12,7 @@ namespace rtfuse::test {
 std::uint64_t allocation_count() noexcept;
 }
 
-namespace {
+namespace ring_payload_test {
 
 struct alignas(32) Sample {
   std::int64_t stamp = 0;
@@ -46,4 +46,4 @@ TEST(GeometrySpscRingEigenPayload, PushPopWithoutAnyAllocation) {
   EXPECT_EQ(after, before);
 }
 
-}  // namespace
+}  // namespace ring_payload_test

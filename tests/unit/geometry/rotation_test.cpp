@@ -6,7 +6,7 @@
 
 #include "geometry/angles.hpp"
 
-namespace {
+namespace rotation_test {
 
 using namespace rtfuse::geometry;
 
@@ -152,4 +152,4 @@ TEST(GeometryRotation, KnownQuaternionToRpy) {
   EXPECT_NEAR(r2.z(), 0.0, 1e-15);
 }
 
-}  // namespace
+}  // namespace rotation_test

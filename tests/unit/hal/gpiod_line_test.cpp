@@ -12,7 +12,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal {
-namespace {
+namespace gpiod_line_test {
 
 constexpr TimeNs kMs = 1'000'000;
 
@@ -380,5 +380,5 @@ TEST(GpiodOutputTest, SetFailureMapsErrnoAndDoesNotAllocate) {
   EXPECT_STREQ(out->last_error(), "gpio gpiochip0 line 3: setting the line low failed: No such device");
 }
 
-}  // namespace
+}  // namespace gpiod_line_test
 }  // namespace rtfuse::hal

@@ -16,7 +16,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal {
-namespace {
+namespace i2c_dev_bus_test {
 
 // Scripted ioctl. Plain globals: the seam is a function pointer, and the
 // recording must not allocate (the allocation test runs through it).
@@ -547,5 +547,5 @@ TEST_F(I2cDevBusTest, SteadyStateTransfersDoNotAllocate) {
   EXPECT_EQ(bus->retries(), 3);  // 1 in the warm-up, 2 in the scope
 }
 
-}  // namespace
+}  // namespace i2c_dev_bus_test
 }  // namespace rtfuse::hal

@@ -6,7 +6,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace mock_can_bus_test {
 
 using rtfuse::TimeNs;
 using rtfuse::hal::CanBusState;
@@ -261,4 +261,4 @@ TEST(HalMockCanBus, SteadyStateDoesNotAllocate) {
   EXPECT_EQ(scope.count(), 0U);
 }
 
-}  // namespace
+}  // namespace mock_can_bus_test

@@ -6,7 +6,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace mock_gpio_test {
 
 using rtfuse::TimeNs;
 using rtfuse::hal::GpioEdge;
@@ -135,4 +135,4 @@ TEST(HalMockGpio, SteadyStateDoesNotAllocate) {
   EXPECT_EQ(scope.count(), 0U);
 }
 
-}  // namespace
+}  // namespace mock_gpio_test

@@ -9,7 +9,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace mock_serial_port_test {
 
 using rtfuse::TimeNs;
 using rtfuse::hal::HalStatus;
@@ -227,4 +227,4 @@ TEST(HalMockSerialPort, ReadWriteAndFeedDoNotAllocate) {
   EXPECT_EQ(clock.now(), 200 * 100 * kMs);
 }
 
-}  // namespace
+}  // namespace mock_serial_port_test

@@ -8,7 +8,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal::mock {
-namespace {
+namespace mock_video_stream_test {
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kPeriod = 10 * kMs;  // 100 fps
@@ -282,5 +282,5 @@ TEST_F(MockVideoStreamTest, DequeueAndReleaseDoNotAllocate) {
   EXPECT_EQ(stream_.stats().corrupted, 10);
 }
 
-}  // namespace
+}  // namespace mock_video_stream_test
 }  // namespace rtfuse::hal::mock

@@ -14,7 +14,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal {
-namespace {
+namespace monotonic_clock_test {
 using mock::SimClock;
 
 constexpr TimeNs kMs = 1'000'000;
@@ -155,5 +155,5 @@ TEST(SimClock, FixedRateLoopRunsInLockstep) {
   EXPECT_EQ(allocations, 0u);
 }
 
-}  // namespace
+}  // namespace monotonic_clock_test
 }  // namespace rtfuse::hal

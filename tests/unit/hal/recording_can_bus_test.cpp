@@ -6,7 +6,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace recording_can_bus_test {
 
 using rtfuse::SpscRing;
 using rtfuse::TimeNs;
@@ -175,4 +175,4 @@ TEST(HalRecordingCanBus, CallsDoNotAllocate) {
   EXPECT_EQ(scope.count(), 0u);
 }
 
-}  // namespace
+}  // namespace recording_can_bus_test

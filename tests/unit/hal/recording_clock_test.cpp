@@ -5,7 +5,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace recording_clock_test {
 
 using rtfuse::SpscRing;
 using rtfuse::hal::BusEvent;
@@ -49,4 +49,4 @@ TEST(HalRecordingClock, OverflowIsCountedAndCallsDoNotAllocate) {
   EXPECT_EQ(clock.overflows(), 12);
 }
 
-}  // namespace
+}  // namespace recording_clock_test

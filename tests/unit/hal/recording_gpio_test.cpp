@@ -6,7 +6,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace recording_gpio_test {
 
 using rtfuse::SpscRing;
 using rtfuse::hal::BusEvent;
@@ -87,4 +87,4 @@ TEST(HalRecordingGpio, OverflowIsCountedAndCallsDoNotAllocate) {
   EXPECT_EQ(edges.overflows() + out.overflows(), 17);
 }
 
-}  // namespace
+}  // namespace recording_gpio_test

@@ -7,7 +7,7 @@
 #include "hal/mock/sim_clock.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace recording_i2c_bus_test {
 
 using rtfuse::SpscRing;
 using rtfuse::hal::BusEvent;
@@ -102,4 +102,4 @@ TEST(HalRecordingI2cBus, FullRingCountsAndCallsDoNotAllocate) {
   EXPECT_EQ(ring.size(), 4u);
 }
 
-}  // namespace
+}  // namespace recording_i2c_bus_test

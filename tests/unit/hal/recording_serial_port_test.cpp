@@ -15,7 +15,7 @@
 #include "hal/replay/replay_stream.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace recording_serial_port_test {
 
 using rtfuse::SpscRing;
 using rtfuse::TimeNs;
@@ -214,4 +214,4 @@ TEST(HalReplaySerialPort, OtherBytesWrittenAreADivergenceShowingThem) {
   EXPECT_NE(report.find("driver called serial_write 6 bytes"), std::string::npos) << report;
 }
 
-}  // namespace
+}  // namespace recording_serial_port_test

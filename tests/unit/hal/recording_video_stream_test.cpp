@@ -13,7 +13,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal {
-namespace {
+namespace recording_video_stream_test {
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kPeriod = 10 * kMs;
@@ -207,5 +207,5 @@ TEST(HalRecordingVideoStream, RecordingCallsDoNotAllocate) {
   EXPECT_GT(r.rec.frames_recorded(), 0);
 }
 
-}  // namespace
+}  // namespace recording_video_stream_test
 }  // namespace rtfuse::hal

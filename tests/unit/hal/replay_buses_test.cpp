@@ -18,7 +18,7 @@
 #include "hal/recording_gpio.hpp"
 #include "hal/recording_i2c_bus.hpp"
 
-namespace {
+namespace replay_buses_test {
 
 using namespace rtfuse;  // NOLINT
 using hal::BusEvent;
@@ -137,4 +137,4 @@ TEST(HalReplayBuses, ReplayReturnsWhatTheRecordedBusesReturned) {
   EXPECT_EQ(live[17].status, HalStatus::kTimeout);
 }
 
-}  // namespace
+}  // namespace replay_buses_test

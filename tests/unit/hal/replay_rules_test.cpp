@@ -16,7 +16,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal::replay {
-namespace {
+namespace replay_rules_test {
 
 // A call on a device with one argument, through each kind's own API.
 struct BusCalls {
@@ -248,5 +248,5 @@ TYPED_TEST(ReplayRules, TakingAndDivergingNeverAllocate) {
   EXPECT_EQ(scope.count(), 0u);
 }
 
-}  // namespace
+}  // namespace replay_rules_test
 }  // namespace rtfuse::hal::replay

@@ -10,7 +10,7 @@
 #include "hal/replay/replay_i2c_bus.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace replay_stream_test {
 
 using rtfuse::hal::BusEvent;
 using rtfuse::hal::BusEventKind;
@@ -279,4 +279,4 @@ TEST(HalReplayStream, ReplayCallsDoNotAllocate) {
   EXPECT_EQ(buf[13], 0xA0 + 13);
 }
 
-}  // namespace
+}  // namespace replay_stream_test

@@ -15,7 +15,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal::replay {
-namespace {
+namespace replay_video_stream_test {
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kPeriod = 10 * kMs;
@@ -211,5 +211,5 @@ TEST(HalReplayVideoStream, ALostFrameIsNamed) {
       << report;
 }
 
-}  // namespace
+}  // namespace replay_video_stream_test
 }  // namespace rtfuse::hal::replay

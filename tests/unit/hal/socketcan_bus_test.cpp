@@ -21,7 +21,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace socketcan_bus_test {
 
 using rtfuse::TimeNs;
 using rtfuse::monotonic_now_ns;
@@ -505,4 +505,4 @@ TEST_F(SocketCanPair, SteadyStateSendAndReceiveDoNotAllocate) {
   EXPECT_EQ(bus_->malformed(), 200);
 }
 
-}  // namespace
+}  // namespace socketcan_bus_test

@@ -31,7 +31,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace termios_serial_port_test {
 
 using rtfuse::TimeNs;
 using rtfuse::monotonic_now_ns;
@@ -514,4 +514,4 @@ TEST_F(HalTermiosSerialPort, SteadyStateReadAndWriteDoNotAllocate) {
   EXPECT_EQ(received, 100 * len);
 }
 
-}  // namespace
+}  // namespace termios_serial_port_test

@@ -17,7 +17,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::hal {
-namespace {
+namespace v4l2_stream_test {
 
 // The emulated device. Plain globals: the seam is a table of function
 // pointers, and the allocation test runs through it.
@@ -902,5 +902,5 @@ TEST_F(V4l2StreamTest, DequeueAndReleaseDoNotAllocate) {
   EXPECT_EQ(s->stats().lost, 1);
 }
 
-}  // namespace
+}  // namespace v4l2_stream_test
 }  // namespace rtfuse::hal

@@ -18,7 +18,7 @@
 #include "runtime/devices/device_layout.hpp"
 
 namespace rtfuse {
-namespace {
+namespace camera_device_test {
 
 constexpr int kEyeW = 672;  // VGA
 constexpr int kEyeH = 376;
@@ -141,5 +141,5 @@ TEST(CameraDevice, MessageIsEmptyUntilAFailureThenSaysWhatFailed) {
   EXPECT_NE(lost.find("reopening in 250 ms"), std::string::npos) << lost;
 }
 
-}  // namespace
+}  // namespace camera_device_test
 }  // namespace rtfuse

@@ -7,7 +7,7 @@
 #include <gtest/gtest.h>
 
 namespace rtfuse {
-namespace {
+namespace config_loader_test {
 
 // gtest only (the runtime tests do not link gmock).
 ::testing::AssertionResult StartsWith(const std::string& s, const std::string& prefix) {
@@ -558,5 +558,5 @@ TEST(ConfigLoader, AllErrorsAreReportedTogetherInFileOrder) {
   EXPECT_TRUE(StartsWith(r.errors[3].to_string(), "test.toml:11:12: sensor[0].relative: "));
 }
 
-}  // namespace
+}  // namespace config_loader_test
 }  // namespace rtfuse

@@ -22,7 +22,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse {
-namespace {
+namespace filter_instances_test {
 
 // Wheels that under-read their speed by 10 %, an IMU with yaw, a GNSS
 // antenna 0.5 m ahead of and 1 m above base_link.
@@ -422,5 +422,5 @@ TEST(FilterInstancesConfig, EachMistakeIsNamed) {
   EXPECT_NE(errors_of(too_many).find("instance: at most 2 entries"), std::string::npos) << errors_of(too_many);
 }
 
-}  // namespace
+}  // namespace filter_instances_test
 }  // namespace rtfuse

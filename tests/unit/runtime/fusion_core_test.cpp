@@ -14,7 +14,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse {
-namespace {
+namespace fusion_core_test {
 
 constexpr const char* kTwoYawSources = R"(
 [filter]
@@ -389,5 +389,5 @@ config = [false, false, false, false, false, false, true, true, false, false, fa
   EXPECT_EQ(s.devices[0].values[0], 100);
 }
 
-}  // namespace
+}  // namespace fusion_core_test
 }  // namespace rtfuse

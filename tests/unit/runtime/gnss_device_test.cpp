@@ -16,7 +16,7 @@
 #include "support/gnss_bytes.hpp"
 
 namespace rtfuse {
-namespace {
+namespace gnss_device_test {
 
 constexpr TimeNs kMs = 1'000'000;
 
@@ -245,5 +245,5 @@ config = [true, true, false, false, false, false, false, false, false, false, fa
       << r.errors[0].to_string();
 }
 
-}  // namespace
+}  // namespace gnss_device_test
 }  // namespace rtfuse

@@ -19,7 +19,7 @@
 #include "transport/hal_record_codec.hpp"
 
 namespace rtfuse {
-namespace {
+namespace hal_recording_test {
 
 using namespace transport;  // NOLINT: the records this loads are transport's
 using hal::BusEvent;
@@ -346,5 +346,5 @@ TEST(HalRecordingLoader, CarriesTheRecordedFilesIntoTheInfo) {
   EXPECT_TRUE(rec.outputs.empty()) << "a recorded file is not an output";
 }
 
-}  // namespace
+}  // namespace hal_recording_test
 }  // namespace rtfuse

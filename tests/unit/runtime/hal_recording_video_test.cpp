@@ -15,7 +15,7 @@
 #include "transport/hal_record_codec.hpp"
 
 namespace rtfuse {
-namespace {
+namespace hal_recording_video_test {
 
 using namespace transport;  // NOLINT: the records this loads are transport's
 using hal::VideoEvent;
@@ -116,5 +116,5 @@ TEST(HalVideoLoader, FramesBeyondTheMemoryAllowedAreRefusedBeforeTheyAreHeld) {
   EXPECT_TRUE(load_hal_recording(reader, options, &enough, &err)) << err;
 }
 
-}  // namespace
+}  // namespace hal_recording_video_test
 }  // namespace rtfuse

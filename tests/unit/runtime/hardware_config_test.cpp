@@ -9,7 +9,7 @@
 #include "runtime/devices/device_registry.hpp"
 
 namespace rtfuse {
-namespace {
+namespace hardware_config_test {
 
 std::string all_errors(const ConfigLoadResult& r) {
   std::string s;
@@ -225,5 +225,5 @@ INSTANTIATE_TEST_SUITE_P(
                 "hw.toml:4:9: mpu.model: must be one of auto, mpu6050, mpu6500, mpu9250, got 'bmi088'"}),
     [](const ::testing::TestParamInfo<BadCase>& i) { return std::string(i.param.name); });
 
-}  // namespace
+}  // namespace hardware_config_test
 }  // namespace rtfuse

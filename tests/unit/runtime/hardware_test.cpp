@@ -25,7 +25,7 @@
 #include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse {
-namespace {
+namespace hardware_test {
 
 using sim::CanopenEncoderConfig;
 using sim::CanopenEncoderNode;
@@ -530,5 +530,5 @@ TEST(Hardware, CanConfigWithoutACanBusIsAnError) {
   EXPECT_EQ(err, "[can] is configured but the HAL has no CAN bus");
 }
 
-}  // namespace
+}  // namespace hardware_test
 }  // namespace rtfuse

@@ -19,7 +19,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse {
-namespace {
+namespace navsat_fusion_test {
 
 // Wheel odometry that under-reads its speed by 10 %, an IMU with yaw, and a
 // GNSS antenna 0.5 m ahead of and 1 m above base_link.
@@ -334,5 +334,5 @@ TEST(NavsatConfig, AnAntennaFrameOutsideTheTreeIsRefusedWithTheFix) {
   EXPECT_NE(err.find("frame 'gps' is not connected to 'base_link'"), std::string::npos) << err;
 }
 
-}  // namespace
+}  // namespace navsat_fusion_test
 }  // namespace rtfuse

@@ -21,7 +21,7 @@
 #include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse {
-namespace {
+namespace publisher_test {
 
 constexpr TimeNs kMs = 1'000'000;
 // Copies: gtest binds by reference, and lcm-gen declares these constants
@@ -432,5 +432,5 @@ TEST(Publisher, RawWheelOdometryOncePerNewSample) {
   EXPECT_DOUBLE_EQ(o.twist.covariance[35], 4e-4);
 }
 
-}  // namespace
+}  // namespace publisher_test
 }  // namespace rtfuse

@@ -19,7 +19,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::runtime {
-namespace {
+namespace recorder_test {
 
 using hal::BusEvent;
 using hal::BusEventKind;
@@ -291,5 +291,5 @@ TEST(Recorder, RefusesAnInvalidDeviceTableAndAnUnwritablePath) {
   EXPECT_NE(err.find("cannot create log file /nonexistent-dir/x.lcm"), std::string::npos) << err;
 }
 
-}  // namespace
+}  // namespace recorder_test
 }  // namespace rtfuse::runtime

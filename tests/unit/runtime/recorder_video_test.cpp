@@ -18,7 +18,7 @@
 #include "support/temp_file.hpp"
 
 namespace rtfuse::runtime {
-namespace {
+namespace recorder_video_test {
 
 using hal::HalStatus;
 using hal::VideoFrame;
@@ -172,5 +172,5 @@ TEST(RecorderVideo, AFullRingLosesFramesAndTheLoadSaysWhich) {
       << loaded.warnings[0];
 }
 
-}  // namespace
+}  // namespace recorder_video_test
 }  // namespace rtfuse::runtime

@@ -13,7 +13,7 @@
 #include "runtime/config/toml_reader.hpp"
 
 namespace rtfuse::config {
-namespace {
+namespace toml_guard_test {
 
 // The UTF-8 bytes of code point c (below U+10000).
 std::string utf8(char32_t c) {
@@ -158,5 +158,5 @@ TEST(TomlGuard, ValidTomlPassesUntouched) {
   }
 }
 
-}  // namespace
+}  // namespace toml_guard_test
 }  // namespace rtfuse::config

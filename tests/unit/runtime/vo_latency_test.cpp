@@ -20,7 +20,7 @@
 #include "runtime/fusion/fusion_core.hpp"
 
 namespace rtfuse {
-namespace {
+namespace vo_latency_test {
 
 constexpr const char* kConfig = R"(
 [filter]
@@ -178,5 +178,5 @@ TEST(VoLatency, WithoutLaggedSmoothingTheLatencyShows) {
   EXPECT_GT(position_difference(prompt.last, late.last), 1e-3);
 }
 
-}  // namespace
+}  // namespace vo_latency_test
 }  // namespace rtfuse

@@ -6,7 +6,7 @@
 
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace canopen_encoder_node_test {
 
 using rtfuse::TimeNs;
 using rtfuse::hal::CanFrame;
@@ -425,4 +425,4 @@ TEST(HalMockCanopen, SteadyStatePollingDoesNotAllocate) {
   EXPECT_EQ(tpdos, 2000);
 }
 
-}  // namespace
+}  // namespace canopen_encoder_node_test

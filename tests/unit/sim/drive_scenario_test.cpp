@@ -10,7 +10,7 @@
 #include "sim/truth_trajectory.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace drive_scenario_test {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
@@ -394,11 +394,11 @@ TEST(DriveScenario, SyntaxErrorsAndUnreadableFiles) {
   EXPECT_EQ(error, "/nonexistent/scenario.toml: cannot read the scenario: No such file or directory");
 }
 
-}  // namespace
+}  // namespace drive_scenario_test
 }  // namespace rtfuse::sim
 
 namespace rtfuse::sim {
-namespace {
+namespace drive_scenario_test {
 
 TEST(DriveScenario, GnssReceiverAndItsOutages) {
   const std::string path = "[[path]]\ntype = \"straight\"\nlength_m = 10.0\nspeed_mps = 1.0\n" + kRobot;
@@ -428,5 +428,5 @@ duration_s = 2.0
   EXPECT_NE(load_error(path + "[gnss]\n[[gnss.outage]]\nstart_s = 1.0\n").find("duration_s"), std::string::npos);
 }
 
-}  // namespace
+}  // namespace drive_scenario_test
 }  // namespace rtfuse::sim

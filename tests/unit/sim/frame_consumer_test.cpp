@@ -23,7 +23,7 @@
 #include "sim/sim_robot.hpp"
 #include "support/sim_toml.hpp"
 
-namespace {
+namespace frame_consumer_test {
 
 using namespace rtfuse;  // NOLINT
 
@@ -201,4 +201,4 @@ TEST_F(FrameConsumers, AConsumerThePoolCannotLendToIsRefusedWithTheFix) {
   EXPECT_NE(r.attach_error.find("camera.pool_frames >= 5"), std::string::npos) << r.attach_error;
 }
 
-}  // namespace
+}  // namespace frame_consumer_test

@@ -26,7 +26,7 @@
 #include "support/sim_toml.hpp"
 
 namespace rtfuse {
-namespace {
+namespace hal_replay_test {
 
 using hal::BusEvent;
 using hal::BusEventKind;
@@ -253,5 +253,5 @@ TEST_F(HalReplay, OtherConfigurationIsRefusedWithBothHashes) {
   EXPECT_EQ(check_recording_config(rec_.info, *config_text_, kSimToml), "");
 }
 
-}  // namespace
+}  // namespace hal_replay_test
 }  // namespace rtfuse

@@ -7,7 +7,7 @@
 #include "sim/devices/mpu_register_file.hpp"
 #include "support/alloc_counter.hpp"
 
-namespace {
+namespace mpu_register_file_test {
 
 using rtfuse::hal::HalStatus;
 using rtfuse::hal::I2cRetryPolicy;
@@ -418,4 +418,4 @@ TEST(HalMockMpu, SteadyStateSampleAndReadDoesNotAllocate) {
   EXPECT_EQ(scope.count(), 0U);
 }
 
-}  // namespace
+}  // namespace mpu_register_file_test

@@ -27,7 +27,7 @@
 #include "transport/hal_record_codec.hpp"
 #include "support/sim_toml.hpp"
 
-namespace {
+namespace sim_camera_test {
 
 using namespace rtfuse;  // NOLINT
 
@@ -271,4 +271,4 @@ calibration = "calibration/SN999.conf"
   EXPECT_NE(d.error.find("SN999.conf"), std::string::npos) << d.error;
 }
 
-}  // namespace
+}  // namespace sim_camera_test

@@ -13,7 +13,7 @@
 #include "sim/sim_lcm_robot.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace sim_config_test {
 
 constexpr TimeNs kSec = 1'000'000'000;
 constexpr double kPi = 3.14159265358979323846;
@@ -116,5 +116,5 @@ TEST(SimToml, FusedEstimateBeatsRawWheelOdometry) {
   EXPECT_LT(est_yaw.value(), odom_yaw.value());
 }
 
-}  // namespace
+}  // namespace sim_config_test
 }  // namespace rtfuse::sim

@@ -21,7 +21,7 @@
 #include "support/sim_toml.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace sim_drive_test {
 
 const std::string kSimToml = RTFUSE_SOURCE_DIR "/config/sim.toml";
 const std::string kStraight = RTFUSE_SOURCE_DIR "/config/scenarios/straight.toml";
@@ -143,5 +143,5 @@ TEST(SimulatedDrive, SameDriveTwiceIsBitIdentical) {
   for (int i = 0; i < a.final.num_sensors; ++i) EXPECT_EQ(a.final.sensors[i].accepted, b.final.sensors[i].accepted);
 }
 
-}  // namespace
+}  // namespace sim_drive_test
 }  // namespace rtfuse::sim

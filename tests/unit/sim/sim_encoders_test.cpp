@@ -11,7 +11,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace sim_encoders_test {
 
 using hal::CanFrame;
 using hal::HalStatus;
@@ -298,5 +298,5 @@ TEST(SimEncoders, SameScenarioSameFramesAndNoAllocationPerCall) {
   EXPECT_LT(total, 2400u);
 }
 
-}  // namespace
+}  // namespace sim_encoders_test
 }  // namespace rtfuse::sim

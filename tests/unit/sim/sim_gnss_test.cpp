@@ -14,7 +14,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace sim_gnss_test {
 
 constexpr TimeNs kMs = 1'000'000;
 constexpr TimeNs kSec = 1'000 * kMs;
@@ -159,5 +159,5 @@ TEST(SimGnss, TheSameSeedGivesTheSameBytesAndReadsAllocateNothing) {
   }
 }
 
-}  // namespace
+}  // namespace sim_gnss_test
 }  // namespace rtfuse::sim

@@ -14,7 +14,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace sim_imu_test {
 
 using hal::GpioEdge;
 using hal::HalStatus;
@@ -306,5 +306,5 @@ TEST(SimImu, ModelAndAddressComeFromTheScenario) {
   EXPECT_EQ(who, 0x71);
 }
 
-}  // namespace
+}  // namespace sim_imu_test
 }  // namespace rtfuse::sim

@@ -15,7 +15,7 @@
 #include "support/eigen_no_malloc.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace sim_lcm_robot_test {
 
 constexpr TimeNs kSec = 1'000'000'000;
 constexpr TimeNs kStart = 1'000 * kSec;  // a monotonic clock is rarely near 0
@@ -329,5 +329,5 @@ TEST(SimLcmRobot, NextDueNeverAllocates) {
   EXPECT_GT(probe.count(), 0u);
 }
 
-}  // namespace
+}  // namespace sim_lcm_robot_test
 }  // namespace rtfuse::sim

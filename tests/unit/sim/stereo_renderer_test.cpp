@@ -19,7 +19,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace stereo_renderer_test {
 
 constexpr int kW = 672;
 constexpr int kH = 376;
@@ -440,5 +440,5 @@ TEST(MipTexture, CoarserLevelsHoldTheMean) {
   EXPECT_NEAR(t.sample(0, 11.0f, 10.5f), 120.0f, 1e-4f);  // between two texels
 }
 
-}  // namespace
+}  // namespace stereo_renderer_test
 }  // namespace rtfuse::sim

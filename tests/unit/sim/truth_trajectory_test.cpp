@@ -13,7 +13,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
-namespace {
+namespace truth_trajectory_test {
 
 constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
@@ -362,5 +362,5 @@ TEST(TruthTrajectory, GroundTruthMessageCarriesThePoseAndTwist) {
   EXPECT_EQ(msg.pose.covariance[7], 0.0);
 }
 
-}  // namespace
+}  // namespace truth_trajectory_test
 }  // namespace rtfuse::sim

@@ -17,7 +17,8 @@
 #include "transport/sample_decoder.hpp"
 #include "support/eigen_no_malloc.hpp"
 
-namespace {
+namespace rtfuse::transport {
+namespace allocation_test {
 
 // Counts allocations made inside f, with Eigen's own check armed as well.
 template <class F>
@@ -31,12 +32,6 @@ long allocations_in(F&& f) {
   }
   return n;
 }
-
-}  // namespace
-
-
-namespace rtfuse::transport {
-namespace {
 
 template <class Msg>
 std::vector<std::uint8_t> bytes_of(const Msg& m) {
@@ -147,5 +142,5 @@ TEST(Allocation, LogReaderAndWriterDoNotAllocatePerEvent) {
   std::remove(path.c_str());
 }
 
-}  // namespace
+}  // namespace allocation_test
 }  // namespace rtfuse::transport

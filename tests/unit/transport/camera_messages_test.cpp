@@ -16,7 +16,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::transport {
-namespace {
+namespace camera_messages_test {
 
 StereoCameraInfo zed_vga() {
   StereoCameraInfo m;
@@ -267,5 +267,5 @@ TEST(PreviewEncoder, EncodesWithoutAllocating) {
   EXPECT_GT(bytes, 20 * 672 * 188);
 }
 
-}  // namespace
+}  // namespace camera_messages_test
 }  // namespace rtfuse::transport

@@ -15,7 +15,7 @@
 #include <vector>
 
 namespace rtfuse::transport {
-namespace {
+namespace event_log_test {
 
 // A per-test file in the temp dir, removed afterwards.
 // A log path of this test, removed afterwards.
@@ -374,5 +374,5 @@ TEST(EventLog, WriterRejectsWhatTheReaderWouldRefuse) {
   EXPECT_NE(err.find("No such file or directory"), std::string::npos) << err;
 }
 
-}  // namespace
+}  // namespace event_log_test
 }  // namespace rtfuse::transport

@@ -14,7 +14,7 @@
 #include "support/hal_record_samples.hpp"
 
 namespace rtfuse::transport {
-namespace {
+namespace hal_record_codec_test {
 
 using hal::BusEvent;
 using hal::BusEventKind;
@@ -198,5 +198,5 @@ TEST(HalRecordCodec, ANegativeTickSeqIsRefused) {
   EXPECT_NE(err.find("negative tick seq -1"), std::string::npos) << err;
 }
 
-}  // namespace
+}  // namespace hal_record_codec_test
 }  // namespace rtfuse::transport

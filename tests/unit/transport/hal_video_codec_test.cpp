@@ -10,7 +10,7 @@
 #include "transport/hal_record_codec.hpp"
 
 namespace rtfuse::transport {
-namespace {
+namespace hal_video_codec_test {
 
 using hal::HalStatus;
 using hal::VideoCallKind;
@@ -105,5 +105,5 @@ TEST(HalVideoCodec, AVideoDeviceNeedsAStreamOfItsOwn) {
   EXPECT_STREQ(to_string(DeviceKind::kVideo), "video");
 }
 
-}  // namespace
+}  // namespace hal_video_codec_test
 }  // namespace rtfuse::transport

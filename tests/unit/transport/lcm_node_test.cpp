@@ -7,7 +7,7 @@
 #include <vector>
 
 namespace rtfuse::transport {
-namespace {
+namespace lcm_node_test {
 
 // memq:// only: unit tests never touch the network.
 struct Received {
@@ -81,5 +81,5 @@ TEST(LcmNode, BadUrlIsAnErrorNotACrash) {
   EXPECT_NE(err.find("memq://"), std::string::npos) << err;
 }
 
-}  // namespace
+}  // namespace lcm_node_test
 }  // namespace rtfuse::transport

@@ -14,7 +14,7 @@
 #include "transport/hal_record_codec.hpp"
 
 namespace rtfuse::transport {
-namespace {
+namespace record_bytes_test {
 
 using test::calibration_file;
 using test::camera_info;
@@ -62,5 +62,5 @@ TEST(HalRecordBytes, EveryRecordKindEncodesAsBefore) {
   EXPECT_EQ(xxh64(all.data(), all.size()), 0xa60882f9b5d4ee98ull) << "the bytes of a record changed";
 }
 
-}  // namespace
+}  // namespace record_bytes_test
 }  // namespace rtfuse::transport

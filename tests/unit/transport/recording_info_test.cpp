@@ -12,7 +12,7 @@
 #include "support/hal_record_samples.hpp"
 
 namespace rtfuse::transport {
-namespace {
+namespace recording_info_test {
 
 using test::calibration_file;
 using test::sample_info;
@@ -196,5 +196,5 @@ TEST(HalRecordedFile, LimitsAndDuplicatesAreRefused) {
   EXPECT_FALSE(validate(info, &err));
 }
 
-}  // namespace
+}  // namespace recording_info_test
 }  // namespace rtfuse::transport

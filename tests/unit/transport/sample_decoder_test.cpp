@@ -10,7 +10,7 @@
 #include "transport/encode_buffer.hpp"
 
 namespace rtfuse::transport {
-namespace {
+namespace sample_decoder_test {
 
 using est::SensorKind;
 using est::SensorSample;
@@ -380,11 +380,11 @@ TEST(EncodeBuffer, RefusesWhatDoesNotFit) {
   EXPECT_EQ(encode_into(m, raw, sizeof raw), -1);
 }
 
-}  // namespace
+}  // namespace sample_decoder_test
 }  // namespace rtfuse::transport
 
 namespace rtfuse::transport {
-namespace {
+namespace sample_decoder_test {
 
 TEST_F(SampleDecoderTest, NavSatFixKeepsItsValuesForTheNavsatTransformToJudge) {
   rtfuse::navsat_fix_t m{};
@@ -424,5 +424,5 @@ TEST_F(SampleDecoderTest, NavSatFixKeepsItsValuesForTheNavsatTransformToJudge) {
   EXPECT_EQ(decode(SensorKind::kNavSatFix, good_odometry()), DecodeResult::kWrongType);
 }
 
-}  // namespace
+}  // namespace sample_decoder_test
 }  // namespace rtfuse::transport

@@ -12,7 +12,7 @@
 #include "vision/feature_filters.hpp"
 
 namespace rtfuse::vision {
-namespace {
+namespace circular_matcher_test {
 
 constexpr int kW = 200, kH = 120;
 
@@ -144,5 +144,5 @@ TEST(CircularMatcher, EachCurrentFeatureClosesOneCircleAndCapacityHolds) {
   EXPECT_EQ(matcher.match(s.lp.index, s.rp.index, s.lc.index, s.rc.index, p, nullptr, out.data(), 10), 10);
 }
 
-}  // namespace
+}  // namespace circular_matcher_test
 }  // namespace rtfuse::vision

@@ -6,7 +6,7 @@
 #include <gtest/gtest.h>
 
 namespace rtfuse::vision {
-namespace {
+namespace egomotion_twist_test {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
@@ -92,5 +92,5 @@ TEST(EgomotionTwist, RefusesWhatIsNoMotion) {
   EXPECT_FALSE(egomotion_twist(bad_cov, 0.03).ok);
 }
 
-}  // namespace
+}  // namespace egomotion_twist_test
 }  // namespace rtfuse::vision

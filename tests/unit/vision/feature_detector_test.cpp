@@ -14,7 +14,7 @@
 #include "vision/feature_filters.hpp"
 
 namespace rtfuse::vision {
-namespace {
+namespace feature_detector_test {
 
 struct Responses {
   Plane<std::uint8_t> du, dv;
@@ -206,11 +206,11 @@ TEST(FeatureDetector, MaxFeaturesBoundsWhatIsFound) {
   EXPECT_EQ(max_features(613, 185, p), 148 * 41 * 4);
 }
 
-}  // namespace
+}  // namespace feature_detector_test
 }  // namespace rtfuse::vision
 
 namespace rtfuse::vision {
-namespace {
+namespace feature_detector_test {
 
 // The vector SAD (SSE2 here, NEON on aarch64) equals the one written out.
 TEST(FeatureDetector, DescriptorSadEqualsThePlainSum) {
@@ -228,5 +228,5 @@ TEST(FeatureDetector, DescriptorSadEqualsThePlainSum) {
   EXPECT_EQ(descriptor_sad(a, b), 32 * 255);
 }
 
-}  // namespace
+}  // namespace feature_detector_test
 }  // namespace rtfuse::vision

@@ -9,7 +9,7 @@
 #include <tuple>
 
 namespace rtfuse::vision {
-namespace {
+namespace feature_filters_test {
 
 Plane<std::uint8_t> random_image(int w, int h, std::uint32_t seed) {
   Plane<std::uint8_t> img(w, h);
@@ -116,5 +116,5 @@ TEST(FeatureFilters, HalveIsTheTruncatedMeanOfEachSquare) {
     }
 }
 
-}  // namespace
+}  // namespace feature_filters_test
 }  // namespace rtfuse::vision

@@ -9,7 +9,7 @@
 #include <vector>
 
 namespace rtfuse::vision {
-namespace {
+namespace feature_index_test {
 
 TEST(FeatureIndex, FindsExactlyWhatAScanFinds) {
   const int w = 120, h = 80;
@@ -82,5 +82,5 @@ TEST(FeatureIndex, KeepsAtMostItsCapacityAndSkipsImpossibleFeatures) {
   EXPECT_EQ(got, (std::vector<int>{0, 1, 4, 5, 6, 7}));
 }
 
-}  // namespace
+}  // namespace feature_index_test
 }  // namespace rtfuse::vision

@@ -9,7 +9,7 @@
 #include <cmath>
 
 namespace rtfuse::vision {
-namespace {
+namespace patch_aligner_test {
 
 // A smooth texture, sampled at (u + du, v + dv), plus an exposure offset.
 Plane<std::uint8_t> draw(double du, double dv, double offset = 0.0) {
@@ -66,5 +66,5 @@ TEST(PatchAligner, FlatPatchesBordersAndRunawaysAreRefused) {
   EXPECT_FALSE(a.align(ref, 60, 32, 1.5, &u, &v));             // off the image
 }
 
-}  // namespace
+}  // namespace patch_aligner_test
 }  // namespace rtfuse::vision

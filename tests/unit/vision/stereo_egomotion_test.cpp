@@ -15,7 +15,7 @@
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::vision {
-namespace {
+namespace stereo_egomotion_test {
 
 using Vec6 = Eigen::Matrix<double, 6, 1>;
 
@@ -158,5 +158,5 @@ TEST(StereoEgomotion, TooFewOrDegenerateMatchesGiveNoMotion) {
   EXPECT_TRUE(!j.ok || j.inliers < 15) << j.inliers;
 }
 
-}  // namespace
+}  // namespace stereo_egomotion_test
 }  // namespace rtfuse::vision
