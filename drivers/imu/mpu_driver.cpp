@@ -5,13 +5,12 @@
 #include <cstring>
 
 #include "drivers/imu/mpu_registers.hpp"
+#include "core/physical_constants.hpp"
 
 namespace rtfuse::drivers {
 
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kStandardGravity = 9.80665;
 constexpr double kMinTemperatureC = -40.0;  // the chips' operating range
 constexpr double kMaxTemperatureC = 85.0;
 // After the 100 ms reset delay, PWR_MGMT_1 is polled this many times, 10 ms apart.

@@ -1,12 +1,11 @@
 #include "drivers/imu/mpu_model.hpp"
 
 #include "drivers/imu/mpu_registers.hpp"
+#include "core/physical_constants.hpp"
 
 namespace rtfuse::drivers {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kStandardGravity = 9.80665;
 
 int clamp_dlpf(int dlpf) noexcept { return dlpf < 0 ? 0 : (dlpf > 6 ? 6 : dlpf); }
 }  // namespace

@@ -1,11 +1,11 @@
 #include "drivers/wheel/planar_pose.hpp"
+#include "core/physical_constants.hpp"
 
 #include <cmath>
 
 namespace rtfuse::drivers {
 
 namespace {
-constexpr double kPi = 3.14159265358979323846;
 
 // sin(a)/a without the 0/0: the series is exact to double precision below 1e-4.
 double sinc(double a) {

@@ -2,9 +2,11 @@
 // Angle normalisation shared by the filter (yaw innovations) and config.
 #include <cmath>
 
+#include "core/physical_constants.hpp"
+
 namespace rtfuse::geometry {
 
-constexpr double kPi = 3.14159265358979323846;
+using rtfuse::kPi;
 constexpr double kTwoPi = 2.0 * kPi;
 
 // Wraps to [-pi, pi). std::remainder is exact for every finite input, so large

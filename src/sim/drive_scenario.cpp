@@ -9,6 +9,7 @@
 
 #include "runtime/config/toml_reader.hpp"
 #include "sim/path_plan.hpp"
+#include "core/physical_constants.hpp"
 
 namespace rtfuse::sim {
 
@@ -21,9 +22,7 @@ using config::read_int;
 using config::read_number;
 using config::Section;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kDeg = kPi / 180.0;
-constexpr double kStandardGravity = 9.80665;
 
 auto in_range(double lo, double hi) {
   return [lo, hi](double v) { return v > lo && v <= hi; };

@@ -1,4 +1,5 @@
 #include "sim/path_plan.hpp"
+#include "core/physical_constants.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -30,7 +31,6 @@ namespace {
 using plan_detail::Phase;
 using plan_detail::Piece;
 
-constexpr double kPi = 3.14159265358979323846;
 constexpr double kKnotStep = 0.05;  // m; quadrature over at most this keeps 1e-12 m at 0.1 m radius
 constexpr std::size_t kMaxKnots = std::size_t{1} << 21;  // ~100 km of path, 32 MB of knots
 // A closed curve whose heading swings as A(1 - cos(2 pi s / S)) ends where it

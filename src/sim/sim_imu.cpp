@@ -4,6 +4,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/physical_constants.hpp"
 #include "geometry/rotation.hpp"
 #include "sim/counter_rng.hpp"
 
@@ -63,7 +64,7 @@ ImuChipReading SimImu::ideal_sample(std::int64_t k) const noexcept {
   // acceleration, the lever arm's tangential (dw x p) and centripetal
   // (w x (w x p)) parts, and the floor pushing up against gravity.
   const double f[3] = {s.accel_body[0] - dw * py - w * w * px, s.accel_body[1] + dw * px - w * w * py,
-                       s.accel_body[2] + sim::mpu::kStandardGravity};
+                       s.accel_body[2] + kStandardGravity};
   const double rate[3] = {0.0, 0.0, w};
   ImuChipReading out;
   for (int i = 0; i < 3; ++i) {  // IMU axes: the transpose of base_link <- IMU

@@ -2,6 +2,8 @@
 
 #include <cmath>
 
+#include "core/physical_constants.hpp"
+
 namespace rtfuse::sim {
 
 namespace mpu {
@@ -115,7 +117,7 @@ bool MpuRegisterFile::set_sample(const double accel_mps2[3], const double gyro_r
   for (int i = 0; i < 3; ++i) {
     if (!std::isfinite(accel_mps2[i]) || !std::isfinite(gyro_rad_s[i])) return false;
   }
-  const double a_scale = mpu::accel_lsb_per_g(accel_fs_sel()) / mpu::kStandardGravity;
+  const double a_scale = mpu::accel_lsb_per_g(accel_fs_sel()) / kStandardGravity;
   const double g_scale = mpu::gyro_lsb_per_dps(gyro_fs_sel()) * 180.0 / kPi;
   std::int16_t a[3];
   std::int16_t g[3];

@@ -20,6 +20,7 @@
 #include <cstdint>
 
 #include "hal/mock/mock_i2c_bus.hpp"
+#include "core/physical_constants.hpp"
 
 namespace rtfuse::sim {
 
@@ -45,9 +46,6 @@ constexpr std::uint8_t kPwrSleep = 0x40;
 constexpr std::uint8_t kIntRdClear = 0x10;
 constexpr std::uint8_t kDataRdyEn = 0x01;
 constexpr std::uint8_t kDataRdyInt = 0x01;
-
-// The conversion the model uses from m/s^2 to g; a driver must use the same.
-constexpr double kStandardGravity = 9.80665;
 
 std::uint8_t who_am_i(MpuChip model) noexcept;
 std::uint8_t pwr_mgmt_1_reset_value(MpuChip model) noexcept;

@@ -16,6 +16,7 @@
 #include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 #include "hal/mock/mock_i2c_bus.hpp"
+#include "core/physical_constants.hpp"
 #include "sim/devices/mpu_register_file.hpp"
 #include "hal/mock/scripted_gpio.hpp"
 #include "hal/mock/sim_clock.hpp"
@@ -409,7 +410,7 @@ struct ImuRig {
     ++n;
     // A small varying x so consecutive samples are never identical (the
     // driver calls a chip that repeats itself frozen).
-    const double accel[3] = {2e-3 * (n % 7), 0.0, sim::mpu::kStandardGravity};
+    const double accel[3] = {2e-3 * (n % 7), 0.0, kStandardGravity};
     const double gyro[3] = {0.0, 0.0, yaw_rate};
     if (!chip.set_sample(accel, gyro, 25.0)) ++chip_refused;
     edges.push(t);
