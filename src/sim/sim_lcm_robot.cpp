@@ -11,12 +11,11 @@
 #include "rtfuse/imu_t.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "transport/encode_buffer.hpp"
+#include "core/physical_constants.hpp"
 
 namespace rtfuse::sim {
 namespace {
 
-constexpr double kPi = 3.14159265358979323846;
-constexpr double kGravity = 9.80665;
 constexpr TimeNs kNever = std::numeric_limits<TimeNs>::max();
 constexpr int kMargin = 64;
 // What a wheel-odometry node reports for a pose it only dead-reckons, and for
@@ -31,7 +30,7 @@ constexpr double kMinVariance = 1e-9;
 // proportional to it: the reason wheel odometry is worst at heading.
 constexpr double kTrackWidth = 0.4;
 
-double wrap(double a) noexcept { return std::remainder(a, 2.0 * kPi); }
+double wrap_yaw(double a) noexcept { return std::remainder(a, 2.0 * kPi); }
 double variance(double sigma) noexcept { return std::max(sigma * sigma, kMinVariance); }
 
 // Derives independent stream seeds from the one config seed.
@@ -115,7 +114,7 @@ class FigureEight {
     k.y = -s0 * px + c0 * py;
     k.v = std::hypot(dx, dy);
     if (k.v > 1e-12) {
-      k.yaw = wrap(std::atan2(dy, dx) - 0.25 * kPi);
+      k.yaw = wrap_yaw(std::atan2(dy, dx) - 0.25 * kPi);
       k.yaw_rate = (dx * ddy - dy * ddx) / (k.v * k.v);
       k.accel = (dx * ddx + dy * ddy) / k.v;
     }
@@ -245,7 +244,7 @@ void SimLcmRobot::Impl::build_imu(TimeNs stamp) noexcept {
   last_imu_stamp = stamp;
   const double a = std::exp(-dt / cfg.yaw_error_time_s);
   yaw_error = a * yaw_error + cfg.yaw_error_rad * std::sqrt(1.0 - a * a) * imu_noise();
-  set_quaternion(m.orientation, so * imu_noise(), so * imu_noise(), wrap(k.yaw + yaw_error + so * imu_noise()));
+  set_quaternion(m.orientation, so * imu_noise(), so * imu_noise(), wrap_yaw(k.yaw + yaw_error + so * imu_noise()));
   // An honest driver reports the error it knows it has, not the white-noise level.
   set_diagonal(m.orientation_covariance, 3, 2, variance(so) + variance(cfg.yaw_error_rad));
 
@@ -259,7 +258,7 @@ void SimLcmRobot::Impl::build_imu(TimeNs stamp) noexcept {
   const double sa = cfg.accel_noise_mps2;
   m.linear_acceleration.x = k.accel + biases.accel[0] + sa * imu_noise();
   m.linear_acceleration.y = k.v * k.yaw_rate + biases.accel[1] + sa * imu_noise();
-  m.linear_acceleration.z = kGravity + biases.accel[2] + sa * imu_noise();
+  m.linear_acceleration.z = kStandardGravity + biases.accel[2] + sa * imu_noise();
 }
 
 void SimLcmRobot::Impl::build_odom(TimeNs stamp) noexcept {
@@ -276,7 +275,7 @@ void SimLcmRobot::Impl::build_odom(TimeNs stamp) noexcept {
     const double mid = odom_yaw + 0.5 * vyaw * dt;
     odom_x += vx * std::cos(mid) * dt;
     odom_y += vx * std::sin(mid) * dt;
-    odom_yaw = wrap(odom_yaw + vyaw * dt);
+    odom_yaw = wrap_yaw(odom_yaw + vyaw * dt);
   }
   odom_started = true;
   odom_last = stamp;
