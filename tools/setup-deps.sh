@@ -44,6 +44,11 @@ packages=(
   # GeographicLib robot_localization projects with; never linked into the
   # runtime (src/estimation/geodesy.hpp says why)
   libgeographiclib-dev
+  # the occupancy map's reference in the test build (tests/reference and its
+  # benchmark): OctoMap's own maps and .bt files; never linked into the runtime
+  liboctomap-dev
+  # OctoMap's scan.dat comes bzip2-compressed (tests/reference reads it)
+  bzip2
 )
 
 missing=()
