@@ -5,6 +5,17 @@
 
 namespace rtfuse::mapping {
 
+BrickCapacity capacity_for_bytes(std::size_t bytes) noexcept {
+  const std::size_t brick_bytes = sizeof(Brick) + 4 * sizeof(std::uint32_t);  // table at most half full
+  const std::size_t block_bytes = (kSubVoxels + 1) * sizeof(std::uint32_t);   // values and a free-list slot
+  std::size_t bricks = bytes / 8 / brick_bytes;
+  std::size_t blocks = (bytes - bytes / 8) / block_bytes;
+  if (bricks < 1) bricks = 1;
+  if (bricks > (1u << 30)) bricks = 1u << 30;
+  if (blocks > kMaxDenseBlocks) blocks = kMaxDenseBlocks;
+  return BrickCapacity{static_cast<std::uint32_t>(bricks), static_cast<std::uint32_t>(blocks)};
+}
+
 BrickStore::BrickStore(BrickCapacity capacity) : capacity_(capacity) {
   if (capacity.bricks == 0 || capacity.bricks > (1u << 30)) {
     throw std::invalid_argument("occupancy map: brick pool of " + std::to_string(capacity.bricks) +

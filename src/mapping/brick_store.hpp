@@ -60,6 +60,11 @@ struct BrickCapacity {
   std::uint32_t dense_blocks = 0;
 };
 
+// A pool of about `bytes`: an eighth for bricks (with their share of the
+// hash table), the rest for dense blocks, the split OctoMap's real scans
+// need (about six dense blocks a brick, tests/reference).
+BrickCapacity capacity_for_bytes(std::size_t bytes) noexcept;
+
 class BrickStore {
  public:
   explicit BrickStore(BrickCapacity capacity);
