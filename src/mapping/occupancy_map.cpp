@@ -156,7 +156,9 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     }
   }
 
-  const auto free = [&](const VoxelKey& key) { writer.update(key, log_odds_.miss, result.frees); };
+  const auto free = [&](const VoxelKey& key) __attribute__((always_inline)) {
+    writer.update(key, log_odds_.miss, result.frees);
+  };
   const float range = static_cast<float>(max_range);
   for (std::size_t i = 0; i < count; ++i) {
     const MapPoint& p = points[i];
