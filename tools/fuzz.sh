@@ -33,7 +33,7 @@ while (($#)); do
     *) harnesses+=("$1"); shift ;;
   esac
 done
-all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss daemon_input)
+all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss point_cloud daemon_input)
 ((${#harnesses[@]})) || harnesses=("${all[@]}")
 
 "$root/tools/setup-deps.sh"
@@ -62,6 +62,11 @@ if [[ -d "$data/kitti" ]]; then
     [[ -f "$d/poses.txt" ]] && { printf '\x00'; head -n 20 "$d/poses.txt"; } >"$seeds/kitti/poses$n"
   done
 fi
+# OctoMap's real scan, its first lines (a cloud of a few hundred points).
+if [[ -f "$data/octomap/scan.dat.bz2" ]]; then
+  { bzip2 -dc "$data/octomap/scan.dat.bz2" || true; } | head -n 300 >"$seeds/point_cloud/scan300.xyz"
+fi
+printf '# a comment, a blank line, signs and exponents\n\n+1.5 -2e-1 0.25\n 3 4 5 \n' >"$seeds/point_cloud/small.xyz"
 "$dir/tests/fuzz/make_seeds" "$seeds" >/dev/null
 for h in "${all[@]}"; do
   [[ -d "$root/tests/fuzz/regressions/$h" ]] && cp "$root/tests/fuzz/regressions/$h"/* "$seeds/$h/"
