@@ -4,12 +4,15 @@
 //
 //   rtfuse-map --cloud SCAN.xyz --origin X,Y,Z --resolution R
 //              [--max-range M] [--repeat K] [--pool-mib N] --out MAP.bt
+//              [--grid PREFIX [--z-min A] [--z-max B]]
 //
 // The cloud is inserted K times, each into an emptied map (the figure is
 // the median), and the last map written. The last stdout line is a JSON
 // object: points, ms_median, known and occupied voxels, memory_bytes (the
 // map's bytes in use, comparable with OctoMap's memoryUsage()), the pool,
-// the file and the map's digest.
+// the file and the map's digest. --grid also writes the 2-D projection
+// between two heights over everything known, as map_server's PREFIX.pgm
+// and PREFIX.yaml.
 #include <CLI/CLI.hpp>
 
 #include <algorithm>
@@ -24,6 +27,8 @@
 #include <vector>
 
 #include "apps/point_cloud_file.hpp"
+#include "mapping/grid_projection.hpp"
+#include "mapping/map_server_files.hpp"
 #include "mapping/map_digest.hpp"
 #include "mapping/octomap_binary.hpp"
 #include "mapping/occupancy_map.hpp"
@@ -31,6 +36,37 @@
 namespace {
 
 using namespace rtfuse::mapping;
+
+bool write_file(const std::string& path, const void* data, std::size_t size) {
+  std::ofstream out(path, std::ios::binary);
+  if (!out || !out.write(static_cast<const char*>(data), static_cast<std::streamsize>(size)) || !out.flush()) {
+    std::fprintf(stderr, "rtfuse-map: %s: cannot write: %s\n", path.c_str(), std::strerror(errno));
+    return false;
+  }
+  return true;
+}
+
+// The smallest grid holding every known voxel column between the heights.
+GridSpec grid_of_known(const OccupancyMap& map, double z_min, double z_max) {
+  int x0 = 65536, y0 = 65536, x1 = -1, y1 = -1;
+  map.for_each_voxel([&](const VoxelKey& k, float) {
+    const double z = map.grid().centre(k.k[2]);
+    if (z < z_min || z > z_max) return;
+    x0 = std::min(x0, int{k.k[0]});
+    x1 = std::max(x1, int{k.k[0]});
+    y0 = std::min(y0, int{k.k[1]});
+    y1 = std::max(y1, int{k.k[1]});
+  });
+  GridSpec spec;
+  spec.z_min = z_min;
+  spec.z_max = z_max;
+  if (x1 < 0) return spec;  // nothing known there: an empty grid
+  spec.first_x = static_cast<std::uint16_t>(x0);
+  spec.first_y = static_cast<std::uint16_t>(y0);
+  spec.width = x1 - x0 + 1;
+  spec.height = y1 - y0 + 1;
+  return spec;
+}
 
 bool parse_origin(const std::string& text, MapPoint& origin) {
   char tail = 0;
@@ -56,6 +92,11 @@ int main(int argc, char** argv) {
   app.add_option("--pool-mib", pool_mib, "memory reserved for the map (MiB); a full pool drops updates, counted")
       ->check(CLI::Range(1, 1 << 20));
   app.add_option("-o,--out", out_path, "the map as OctoMap's binary tree (.bt)")->required();
+  std::string grid_prefix;
+  double z_min = -0.5, z_max = 2.0;
+  app.add_option("--grid", grid_prefix, "also write the 2-D grid as map_server's PREFIX.pgm and PREFIX.yaml");
+  app.add_option("--z-min", z_min, "the grid's lowest voxel centres (metres)");
+  app.add_option("--z-max", z_max, "the grid's highest voxel centres (metres)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -104,11 +145,24 @@ int main(int argc, char** argv) {
   OctomapBinaryWriter writer(capacity.bricks);
   std::vector<std::uint8_t> file;
   const std::size_t nodes = writer.write(map, file);
-  {
-    std::ofstream out(out_path, std::ios::binary);
-    if (!out || !out.write(reinterpret_cast<const char*>(file.data()), static_cast<std::streamsize>(file.size())) ||
-        !out.flush()) {
-      std::fprintf(stderr, "rtfuse-map: %s: cannot write: %s\n", out_path.c_str(), std::strerror(errno));
+  if (!write_file(out_path, file.data(), file.size())) return 1;
+  ProjectionCounts grid_counts;
+  GridSpec spec;
+  if (!grid_prefix.empty()) {
+    if (!(z_min <= z_max)) {
+      std::fprintf(stderr, "rtfuse-map: --z-min %g is above --z-max %g\n", z_min, z_max);
+      return 2;
+    }
+    spec = grid_of_known(map, z_min, z_max);
+    std::vector<std::int8_t> cells(spec.cells());
+    grid_counts = project_to_grid(map, spec, cells.data());
+    const std::vector<std::uint8_t> pgm = map_server_pgm(cells.data(), spec.width, spec.height);
+    const std::string image = grid_prefix + ".pgm";
+    const std::string base = image.substr(image.find_last_of('/') + 1);
+    const std::string yaml = map_server_yaml(base, map.grid().resolution(), grid_origin_x(map.grid(), spec),
+                                             grid_origin_y(map.grid(), spec));
+    if (!write_file(image, pgm.data(), pgm.size()) ||
+        !write_file(grid_prefix + ".yaml", yaml.data(), yaml.size())) {
       return 1;
     }
   }
@@ -126,10 +180,11 @@ int main(int argc, char** argv) {
       "\"hits\": %u, \"frees\": %u, \"beyond_range\": %u, \"outside\": %u, \"rejected\": %u, "
       "\"known_voxels\": %" PRIu64 ", \"occupied_voxels\": %" PRIu64 ", \"dropped_updates\": %u, "
       "\"memory_bytes\": %zu, \"pool_bytes\": %zu, \"bt\": \"%s\", \"bt_bytes\": %zu, \"bt_nodes\": %zu, "
-      "\"digest\": \"%016" PRIx64 "\"}\n",
+      "\"digest\": \"%016" PRIx64 "\", \"grid_width\": %d, \"grid_height\": %d, \"grid_occupied\": %zu, "
+      "\"grid_free\": %zu}\n",
       cloud_path.c_str(), cloud.size(), origin.x, origin.y, origin.z, resolution, max_range, repeat, median, sorted[0],
       result.hits, result.frees, result.beyond_range, result.outside, result.rejected, map.known_voxels(),
       map.occupied_voxels(), result.dropped, map.store().bytes_used(), map.store().bytes_reserved(), out_path.c_str(),
-      file.size(), nodes, map_digest(map));
+      file.size(), nodes, map_digest(map), spec.width, spec.height, grid_counts.occupied, grid_counts.free);
   return result.dropped > 0 ? 3 : 0;
 }
