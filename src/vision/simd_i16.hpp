@@ -56,6 +56,27 @@ struct PlainI16 {
     for (int i = 0; i < 8; ++i) r |= mask.x[i] != 0 ? 1u << i : 0u;
     return r;
   }
+  // Wrapping (two's complement) sums and differences, as the vector units do.
+  static V add(V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = static_cast<std::int16_t>(static_cast<std::uint16_t>(a.x[i]) + static_cast<std::uint16_t>(b.x[i]));
+    return a;
+  }
+  static V sub(V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = static_cast<std::int16_t>(static_cast<std::uint16_t>(a.x[i]) - static_cast<std::uint16_t>(b.x[i]));
+    return a;
+  }
+  // Eight bytes, zero-extended.
+  static V load_u8(const std::uint8_t* p) noexcept {
+    V r;
+    for (int i = 0; i < 8; ++i) r.x[i] = p[i];
+    return r;
+  }
+  // The least lane.
+  static int hmin(V a) noexcept {
+    int m = a.x[0];
+    for (int i = 1; i < 8; ++i) m = a.x[i] < m ? a.x[i] : m;
+    return m;
+  }
 };
 
 #if defined(__SSE2__)
@@ -70,6 +91,17 @@ struct NativeI16 {
   static V select(V mask, V a, V b) noexcept { return _mm_or_si128(_mm_and_si128(mask, a), _mm_andnot_si128(mask, b)); }
   static unsigned bits(V mask) noexcept {
     return static_cast<unsigned>(_mm_movemask_epi8(_mm_packs_epi16(mask, _mm_setzero_si128()))) & 0xffu;
+  }
+  static V add(V a, V b) noexcept { return _mm_add_epi16(a, b); }
+  static V sub(V a, V b) noexcept { return _mm_sub_epi16(a, b); }
+  static V load_u8(const std::uint8_t* p) noexcept {
+    return _mm_unpacklo_epi8(_mm_loadl_epi64(reinterpret_cast<const __m128i*>(p)), _mm_setzero_si128());
+  }
+  static int hmin(V a) noexcept {
+    a = _mm_min_epi16(a, _mm_shuffle_epi32(a, _MM_SHUFFLE(1, 0, 3, 2)));
+    a = _mm_min_epi16(a, _mm_shuffle_epi32(a, _MM_SHUFFLE(2, 3, 0, 1)));
+    a = _mm_min_epi16(a, _mm_shufflelo_epi16(a, _MM_SHUFFLE(2, 3, 0, 1)));
+    return static_cast<std::int16_t>(_mm_cvtsi128_si32(a));
   }
 };
 constexpr bool kNativeIsVector = true;
@@ -87,6 +119,10 @@ struct NativeI16 {
     static const std::uint16_t kBit[8] = {1, 2, 4, 8, 16, 32, 64, 128};
     return vaddvq_u16(vandq_u16(vreinterpretq_u16_s16(mask), vld1q_u16(kBit)));
   }
+  static V add(V a, V b) noexcept { return vaddq_s16(a, b); }
+  static V sub(V a, V b) noexcept { return vsubq_s16(a, b); }
+  static V load_u8(const std::uint8_t* p) noexcept { return vreinterpretq_s16_u16(vmovl_u8(vld1_u8(p))); }
+  static int hmin(V a) noexcept { return vminvq_s16(a); }
 };
 constexpr bool kNativeIsVector = true;
 #else

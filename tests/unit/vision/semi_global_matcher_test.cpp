@@ -1,0 +1,345 @@
+// The dense stereo matcher on synthetic rectified pairs whose disparity is
+// known exactly: a textured plane shifted by an integer and by a fraction,
+// a slanted plane, a foreground square whose occlusion band the left-right
+// check must remove; the invalid border; bad input refused without a crash;
+// the same bytes twice and from every backend; no allocation per frame.
+#include "vision/semi_global_matcher.hpp"
+
+#include <gtest/gtest.h>
+
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <cstring>
+#include <functional>
+#include <random>
+#include <vector>
+
+#include "support/alloc_counter.hpp"
+#include "vision/census_cost.hpp"
+#include "vision/census_transform.hpp"
+#include "vision/disparity_selection.hpp"
+
+namespace rtfuse::vision {
+namespace semi_global_matcher_test {
+
+constexpr int kW = 160;
+constexpr int kH = 96;
+
+// A smooth random texture, defined between pixels too (bilinear between
+// random grey levels every 3 px), so a pair can be shifted by a fraction.
+class Texture {
+ public:
+  explicit Texture(std::uint32_t seed, int cells_x = 200, int cells_y = 60) : nx_(cells_x), ny_(cells_y) {
+    std::mt19937 rng(seed);
+    grid_.resize(static_cast<std::size_t>(nx_) * static_cast<std::size_t>(ny_));
+    for (auto& g : grid_) g = static_cast<double>(rng() % 256);
+  }
+  double at(double u, double v) const {
+    const double gu = std::clamp(u / kCell, 0.0, nx_ - 1.001), gv = std::clamp(v / kCell, 0.0, ny_ - 1.001);
+    const int i = static_cast<int>(gu), j = static_cast<int>(gv);
+    const double a = gu - i, b = gv - j;
+    return (1 - a) * (1 - b) * g(i, j) + a * (1 - b) * g(i + 1, j) + (1 - a) * b * g(i, j + 1) + a * b * g(i + 1, j + 1);
+  }
+
+ private:
+  static constexpr double kCell = 3.0;
+  double g(int i, int j) const { return grid_[static_cast<std::size_t>(j) * static_cast<std::size_t>(nx_) + static_cast<std::size_t>(i)]; }
+  int nx_, ny_;
+  std::vector<double> grid_;
+};
+
+std::uint8_t grey(double v) { return static_cast<std::uint8_t>(std::clamp(std::lround(v), 0L, 255L)); }
+
+struct Pair {
+  Plane<std::uint8_t> left{kW, kH}, right{kW, kH};
+};
+
+// left(x, y) = f(x, y); right(x, y) = g(x, y): the caller's scene.
+Pair make_pair(const std::function<double(int, int)>& left, const std::function<double(int, int)>& right) {
+  Pair p;
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      p.left.row(y)[x] = grey(left(x, y));
+      p.right.row(y)[x] = grey(right(x, y));
+    }
+  }
+  return p;
+}
+
+// A fronto-parallel plane at disparity d: right(x) = left(x + d).
+Pair shifted_plane(double d, std::uint32_t seed = 1) {
+  const Texture t(seed);
+  return make_pair([&](int x, int y) { return t.at(x + 10.0, y); }, [&](int x, int y) { return t.at(x + 10.0 + d, y); });
+}
+
+double disparity_px(std::uint16_t v) { return static_cast<double>(v) / kDisparityScale; }
+
+struct Match {
+  Plane<std::uint16_t> out;
+  DisparityStatus status = DisparityStatus::kOk;
+  int valid = 0;
+};
+
+Match run(const Pair& p, const DisparityParams& params = {}) {
+  SemiGlobalMatcher m(kW, kH, params);
+  EXPECT_TRUE(m.valid()) << m.error();
+  Match r{Plane<std::uint16_t>(m.output_width(kW), m.output_height(kH))};
+  r.status = m.compute(view_of(p.left), view_of(p.right), view_of(r.out));
+  r.valid = m.valid_pixels();
+  return r;
+}
+
+// Share of valid pixels with x >= x0 within tol px of truth(x, y), and
+// how many there were.
+double share_within(const Match& r, int x0, double tol, const std::function<double(int, int)>& truth, int* count) {
+  int n = 0, good = 0;
+  for (int y = 0; y < r.out.height(); ++y) {
+    for (int x = x0; x < r.out.width(); ++x) {
+      const std::uint16_t v = r.out.at(x, y);
+      if (v == kInvalidDisparity) continue;
+      ++n;
+      good += std::fabs(disparity_px(v) - truth(x, y)) <= tol ? 1 : 0;
+    }
+  }
+  *count = n;
+  return n > 0 ? static_cast<double>(good) / n : 0.0;
+}
+
+DisparityParams params32() {
+  DisparityParams p;
+  p.disparities = 32;
+  return p;
+}
+
+TEST(SemiGlobalMatcher, IntegerShiftFound) {
+  const Match r = run(shifted_plane(12.0), params32());
+  ASSERT_EQ(r.status, DisparityStatus::kOk);
+  int n = 0;
+  // The winner is right everywhere; the parabola's fraction wanders a
+  // little (census costs are not symmetric about a true integer shift).
+  EXPECT_GE(share_within(r, 32, 0.5, [](int, int) { return 12.0; }, &n), 0.99) << n;
+  EXPECT_GT(n, (kW - 32 - 4) * (kH - 6) * 95 / 100);
+  EXPECT_GE(share_within(r, 32, 0.25, [](int, int) { return 12.0; }, &n), 0.95);
+}
+
+TEST(SemiGlobalMatcher, FractionalShiftWithinAQuarterPixel) {
+  const Match r = run(shifted_plane(7.5), params32());
+  ASSERT_EQ(r.status, DisparityStatus::kOk);
+  int n = 0;
+  EXPECT_GE(share_within(r, 32, 1.0, [](int, int) { return 7.5; }, &n), 0.99);
+  // The parabola's fraction: most estimates nearer 7.5 than the integers
+  // (census costs pull fractions towards whole pixels, so not all).
+  EXPECT_GE(share_within(r, 32, 0.25, [](int, int) { return 7.5; }, &n), 0.7);
+}
+
+TEST(SemiGlobalMatcher, SlantedPlaneWithinOnePixel) {
+  // d = a + b x_left; the right pixel x_r sees x_left = x_r + d, so
+  // d = (a + b x_r) / (1 - b).
+  const double a = 4.0, b = 0.08;
+  const Texture t(2);
+  const Pair p = make_pair([&](int x, int y) { return t.at(x, y); },
+                           [&](int x, int y) { return t.at(x + (a + b * x) / (1 - b), y); });
+  const Match r = run(p, params32());
+  ASSERT_EQ(r.status, DisparityStatus::kOk);
+  int n = 0;
+  EXPECT_GE(share_within(r, 32, 1.0, [&](int x, int) { return a + b * x; }, &n), 0.95);
+  EXPECT_GT(n, (kW - 32) * (kH - 6) * 8 / 10);
+}
+
+// Background at disparity 4, a square at 20 over columns [60, 100) of the
+// left view: left columns [44, 60) show background the right eye cannot see.
+Pair occlusion_scene() {
+  const Texture bg(3), fg(4);
+  auto in_square_rows = [](int y) { return y >= 24 && y < 72; };
+  return make_pair(
+      [&](int x, int y) { return in_square_rows(y) && x >= 60 && x < 100 ? fg.at(x, y) : bg.at(x, y); },
+      [&](int x, int y) { return in_square_rows(y) && x >= 40 && x < 80 ? fg.at(x + 20.0, y) : bg.at(x + 4.0, y); });
+}
+
+int invalid_in_band(const Match& r, int* total) {
+  int invalid = 0;
+  *total = 0;
+  for (int y = 30; y < 66; ++y) {
+    for (int x = 46; x < 58; ++x) {
+      ++*total;
+      invalid += r.out.at(x, y) == kInvalidDisparity ? 1 : 0;
+    }
+  }
+  return invalid;
+}
+
+TEST(SemiGlobalMatcher, LeftRightCheckInvalidatesTheOcclusion) {
+  const Pair p = occlusion_scene();
+  DisparityParams checked = params32();
+  checked.uniqueness_percent = 0;
+  checked.speckle_window = 0;
+  DisparityParams unchecked = checked;
+  unchecked.lr_max_diff = -1;
+  int total = 0;
+  const Match with = run(p, checked), without = run(p, unchecked);
+  const int invalid_with = invalid_in_band(with, &total), invalid_without = invalid_in_band(without, &total);
+  EXPECT_EQ(invalid_without, 0);
+  EXPECT_GE(invalid_with, total * 8 / 10) << invalid_with << " of " << total;
+  // Where both eyes see the surface, the estimates stay.
+  int n = 0;
+  EXPECT_GE(share_within(with, 64, 1.0,
+                         [](int x, int y) { return y >= 24 && y < 72 && x >= 60 && x < 100 ? 20.0 : 4.0; }, &n),
+            0.95);
+}
+
+TEST(SemiGlobalMatcher, BorderAndShortRangeMarkedInvalid) {
+  const Match r = run(shifted_plane(12.0), params32());
+  for (int y = 0; y < kH; ++y) {
+    for (int x = 0; x < kW; ++x) {
+      const bool border = y < kCensusHalfHeight || y >= kH - kCensusHalfHeight || x < kCensusHalfWidth ||
+                          x >= kW - kCensusHalfWidth;
+      if (border) {
+        ASSERT_EQ(r.out.at(x, y), kInvalidDisparity) << x << "," << y;
+      }
+      // Left of column 12 the true match lies outside the right image.
+      if (x < 12 && r.out.at(x, y) != kInvalidDisparity) {
+        ASSERT_LE(disparity_px(r.out.at(x, y)), x + 0.5);
+      }
+    }
+  }
+  EXPECT_NEAR(r.out.at(kW / 2, kH / 2), 12 * kDisparityScale, kDisparityScale / 4);
+}
+
+TEST(SemiGlobalMatcher, HalfResolutionReportsInputPixels) {
+  DisparityParams p;
+  p.disparities = 32;
+  p.downscale = 2;
+  const Match r = run(shifted_plane(12.0), p);
+  ASSERT_EQ(r.status, DisparityStatus::kOk);
+  EXPECT_EQ(r.out.width(), kW / 2);
+  EXPECT_EQ(r.out.height(), kH / 2);
+  int n = 0;
+  EXPECT_GE(share_within(r, 16, 1.0, [](int, int) { return 12.0; }, &n), 0.95);
+  EXPECT_GT(n, 600);
+}
+
+TEST(SemiGlobalMatcher, BadParametersRefusedAtConstruction) {
+  auto refused = [](int w, int h, DisparityParams p) {
+    SemiGlobalMatcher m(w, h, p);
+    return !m.valid() && m.error() != nullptr && std::strlen(m.error()) > 10;
+  };
+  DisparityParams p;
+  EXPECT_TRUE(refused(0, 10, p));
+  EXPECT_TRUE(refused(100, -1, p));
+  p.disparities = 24;  // not a multiple of 16
+  EXPECT_TRUE(refused(640, 480, p));
+  p.disparities = 0;
+  EXPECT_TRUE(refused(640, 480, p));
+  p.disparities = 64;
+  EXPECT_TRUE(refused(64, 480, p));  // range as wide as the image
+  p.downscale = 3;
+  EXPECT_TRUE(refused(640, 480, p));
+  p.downscale = 2;
+  p.disparities = 48;  // 24 at half resolution
+  EXPECT_TRUE(refused(640, 480, p));
+  p = DisparityParams{};
+  p.paths = 6;
+  EXPECT_TRUE(refused(640, 480, p));
+  p = DisparityParams{};
+  p.p2 = 500;
+  EXPECT_TRUE(refused(640, 480, p));
+  p = DisparityParams{};
+  p.uniqueness_percent = 100;
+  EXPECT_TRUE(refused(640, 480, p));
+  EXPECT_TRUE(SemiGlobalMatcher(640, 480, DisparityParams{}).valid());
+  // A refused matcher says so instead of computing.
+  SemiGlobalMatcher bad(0, 0);
+  Plane<std::uint8_t> img(32, 32);
+  Plane<std::uint16_t> out(32, 32);
+  EXPECT_EQ(bad.compute(view_of(img), view_of(img), view_of(out)), DisparityStatus::kNotConstructed);
+}
+
+TEST(SemiGlobalMatcher, BadImagesReturnAStatus) {
+  SemiGlobalMatcher m(kW, kH, params32());
+  ASSERT_TRUE(m.valid());
+  Plane<std::uint8_t> a(kW, kH), b(kW, kH), narrow(kW - 8, kH), big(kW + 16, kH), tiny(32, kH);
+  Plane<std::uint16_t> out(kW, kH), out_big(kW + 16, kH), out_tiny(32, kH);
+  EXPECT_EQ(m.compute(view_of(a), view_of(narrow), view_of(out)), DisparityStatus::kSizeMismatch);
+  EXPECT_EQ(m.compute(view_of(a), view_of(b), view_of(out_tiny)), DisparityStatus::kSizeMismatch);
+  EXPECT_EQ(m.compute(view_of(big), view_of(big), view_of(out_big)), DisparityStatus::kLargerThanWorkspace);
+  EXPECT_EQ(m.compute(view_of(tiny), view_of(tiny), view_of(out_tiny)), DisparityStatus::kRangeTooWide);
+  EXPECT_EQ(m.compute(GreyView{}, view_of(b), view_of(out)), DisparityStatus::kBadImage);
+  GreyView short_stride = view_of(a);
+  short_stride.stride = kW - 1;
+  EXPECT_EQ(m.compute(short_stride, view_of(b), view_of(out)), DisparityStatus::kBadImage);
+  EXPECT_EQ(m.compute(view_of(a), view_of(b), DisparityImage{}), DisparityStatus::kBadImage);
+  EXPECT_STRNE(to_string(DisparityStatus::kRangeTooWide), "unknown");
+}
+
+TEST(SemiGlobalMatcher, SameBytesTwiceAndNoAllocation) {
+  const Pair p = occlusion_scene();
+  SemiGlobalMatcher m(kW, kH, params32());
+  Plane<std::uint16_t> a(kW, kH), b(kW, kH);
+  ASSERT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(a)), DisparityStatus::kOk);
+  {
+    test::AllocScope scope;
+    ASSERT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(b)), DisparityStatus::kOk);
+    EXPECT_EQ(scope.count(), 0u);
+  }
+  for (int y = 0; y < kH; ++y) ASSERT_EQ(std::memcmp(a.row(y), b.row(y), kW * sizeof(std::uint16_t)), 0) << y;
+}
+
+// The vector backends (SSE2 or NEON) against the plain definitions, on
+// random images: census, costs and selection give the same integers.
+TEST(SemiGlobalMatcher, VectorAndPlainBackendsAgree) {
+  std::mt19937 rng(7);
+  const int w = 77, h = 19, d = 32;
+  Plane<std::uint8_t> img(w, h), other(w, h);
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      img.row(y)[x] = static_cast<std::uint8_t>(rng() & 0xff);
+      other.row(y)[x] = static_cast<std::uint8_t>(rng() & 0xff);
+    }
+  }
+  Plane<std::uint8_t> native[kCensusPlanes], plain[kCensusPlanes], right[kCensusPlanes];
+  for (int g = 0; g < kCensusPlanes; ++g) {
+    native[g] = Plane<std::uint8_t>(w, h);
+    plain[g] = Plane<std::uint8_t>(w, h);
+    right[g] = Plane<std::uint8_t>(w, h);
+  }
+  census_transform_9x7(view_of(img), native);
+  census_transform_9x7_portable(view_of(img), plain);
+  census_transform_9x7(view_of(other), right);
+  for (int g = 0; g < kCensusPlanes; ++g) {
+    for (int y = 0; y < h; ++y) ASSERT_EQ(std::memcmp(native[g].row(y), plain[g].row(y), w), 0) << g << "," << y;
+  }
+  const int y = h / 2;
+  std::vector<std::uint8_t> reversed(static_cast<std::size_t>(kCensusPlanes) * (w + d + 32), 0);
+  const std::uint8_t *lp[kCensusPlanes], *rp[kCensusPlanes];
+  for (int g = 0; g < kCensusPlanes; ++g) {
+    std::uint8_t* rev = reversed.data() + static_cast<std::size_t>(g) * (w + d + 32);
+    for (int x = 0; x < w; ++x) rev[w - 1 - x] = right[g].row(y)[x];
+    lp[g] = native[g].row(y);
+    rp[g] = rev;
+  }
+  std::vector<std::uint8_t> cost_native(static_cast<std::size_t>(w) * d + 16), cost_plain(cost_native.size());
+  census_cost_row(lp, rp, w, d, cost_native.data());
+  census_cost_row_portable(lp, rp, w, d, cost_plain.data());
+  ASSERT_EQ(std::memcmp(cost_native.data(), cost_plain.data(), static_cast<std::size_t>(w) * d), 0);
+  std::vector<std::int16_t> sums(static_cast<std::size_t>(w) * d);
+  for (auto& s : sums) s = static_cast<std::int16_t>(rng() % 400);
+  std::vector<std::int16_t> lb(w), rb(w + d), rc(w + d), out_native(w), out_plain(w);
+  const DisparityRowScratch scratch{lb.data(), rb.data(), rc.data()};
+  for (const int uniqueness : {0, 10}) {
+    select_disparity_row(sums.data(), w, d, uniqueness, 1, scratch, out_native.data());
+    select_disparity_row_portable(sums.data(), w, d, uniqueness, 1, scratch, out_plain.data());
+    ASSERT_EQ(out_native, out_plain);
+  }
+}
+
+TEST(SemiGlobalMatcher, SubpixelOffsetIsSymmetricAndBounded) {
+  EXPECT_EQ(subpixel_offset(10, 0, 10), 0);
+  EXPECT_EQ(subpixel_offset(20, 0, 10), -subpixel_offset(10, 0, 20));
+  EXPECT_GT(subpixel_offset(20, 0, 10), 0);  // the vertex leans to the cheaper side
+  EXPECT_LE(std::abs(subpixel_offset(100, 0, 0)), kDisparityScale / 2);
+  EXPECT_EQ(subpixel_offset(5, 5, 5), 0);
+}
+
+}  // namespace semi_global_matcher_test
+}  // namespace rtfuse::vision
