@@ -18,4 +18,11 @@ struct GreyPng {
 // cannot be opened, libpng's message when it is not a readable PNG).
 bool read_grey_png(const std::string& path, GreyPng* out, std::string* error);
 
+// As read_grey_png, but a colour PNG becomes its BT.601 luma computed on the
+// stored (gamma-encoded) values, Y = (77 R + 150 G + 29 B + 128) >> 8: the Y
+// a camera's YUYV carries, which is what the camera path matches on (it
+// keeps Y and drops the chroma). libpng's own grey conversion is a linear-light
+// one that would give other grey levels. Grey PNGs come out unchanged.
+bool read_luma_png(const std::string& path, GreyPng* out, std::string* error);
+
 }  // namespace rtfuse::apps
