@@ -1,0 +1,76 @@
+#include "apps/map_figure.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+#include "apps/legend.hpp"
+
+namespace rtfuse::apps {
+namespace {
+
+constexpr int kScale = 2;
+constexpr Rgb kWhite{255, 255, 255};
+constexpr Rgb kInk{0, 0, 0};
+constexpr Rgb kOccupied{0, 0, 0};
+constexpr Rgb kFree{254, 254, 254};
+constexpr Rgb kUnknown{205, 205, 205};
+constexpr Rgb kPath{220, 40, 40};
+constexpr Rect kView{110, 80, 760, 760};
+constexpr int kColumnX = 930;
+
+}  // namespace
+
+bool write_map_png(const MapFigure& f, const std::string& path, std::string* error) {
+  Canvas canvas(1400, 920, kWhite);
+  canvas.text(kView.x, 20, f.title, kInk, kScale, true);
+  Range xr, yr;
+  xr.include(f.origin_x);
+  xr.include(f.origin_x + f.width * f.resolution);
+  yr.include(f.origin_y);
+  yr.include(f.origin_y + f.height * f.resolution);
+  for (const DataPoint& p : f.path) {
+    xr.include(p.x);
+    yr.include(p.y);
+  }
+  AxesOptions options;
+  options.equal_aspect = true;
+  options.x_title = "x [m]";
+  options.y_title = "y [m]";
+  const Axes axes(kView, xr, yr, options);
+  axes.draw_grid(canvas);
+  // Each cell a rectangle from its corners' pixels: cells of a fraction of
+  // a pixel fall on the same pixel, occupied drawn last so it shows.
+  canvas.set_clip(axes.area());
+  for (const std::int8_t state : {std::int8_t{0}, std::int8_t{-1}, std::int8_t{100}}) {
+    const Rgb colour = state == 100 ? kOccupied : state == 0 ? kFree : kUnknown;
+    for (int j = 0; j < f.height; ++j) {
+      for (int i = 0; i < f.width; ++i) {
+        if (f.cells[static_cast<std::size_t>(j) * static_cast<std::size_t>(f.width) + i] != state) continue;
+        const PointPx a = axes.to_px({f.origin_x + i * f.resolution, f.origin_y + j * f.resolution});
+        const PointPx b = axes.to_px({f.origin_x + (i + 1) * f.resolution, f.origin_y + (j + 1) * f.resolution});
+        const int x0 = static_cast<int>(std::floor(std::min(a.x, b.x)));
+        const int y0 = static_cast<int>(std::floor(std::min(a.y, b.y)));
+        const int x1 = std::max(x0 + 1, static_cast<int>(std::floor(std::max(a.x, b.x))));
+        const int y1 = std::max(y0 + 1, static_cast<int>(std::floor(std::max(a.y, b.y))));
+        canvas.fill_rect({x0, y0, x1 - x0, y1 - y0}, colour);
+      }
+    }
+  }
+  canvas.reset_clip();
+  axes.polyline(canvas, f.path, kPath, 2);
+  if (!f.path.empty()) axes.marker(canvas, f.path.front(), Marker::kCircle, 6, kPath);
+  axes.draw_labels(canvas);
+
+  const std::vector<LegendEntry> legend = {
+      {"occupied (black)", kOccupied, true, Marker::kSquare, 2, false},
+      {"free (white)", Rgb{150, 150, 150}, true, Marker::kSquare, 1, false},
+      {"unknown (grey)", kUnknown, true, Marker::kSquare, 2, false},
+      {"sensor path", kPath, false, Marker::kDisc, 2, false},
+      {"start", kPath, true, Marker::kCircle, 2, false},
+  };
+  const Rect box = draw_legend(canvas, kColumnX, kView.y, legend, kScale);
+  draw_text_lines(canvas, kColumnX, box.bottom() + 30, f.figures, kInk, kScale);
+  return write_png(canvas, path, error);
+}
+
+}  // namespace rtfuse::apps
