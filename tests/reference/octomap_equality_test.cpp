@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/stereo_clouds.hpp"
 #include "mapping/map_digest.hpp"
 #include "mapping/octomap_binary.hpp"
 #include "octomap_reference.hpp"
@@ -141,6 +142,29 @@ TEST(OctomapEquality, ScansFromAMovingSensor) {
     clamped |= v == m.map.log_odds().clamp_min || v == m.map.log_odds().clamp_max;
   });
   EXPECT_TRUE(clamped);
+}
+
+// The project's own depth: dense disparity of the real KITTI 06 pairs
+// (half resolution, 96 disparities) back-projected and placed with the
+// ground truth poses, every third frame from 11 (frames 1-11 of the shared
+// copy repeat one interpolated motion), 15 m range, 0.1 m voxels.
+TEST(OctomapEquality, KittiStereoWithGroundTruthPoses) {
+  rtfuse::apps::KittiSequence seq;
+  std::string error;
+  ASSERT_TRUE(rtfuse::apps::open_kitti_sequence(std::string(RTFUSE_SHARED_DATA) + "/kitti/kitti06_0000_0050", &seq,
+                                                &error))
+      << error;
+  rtfuse::vision::DisparityParams params;
+  params.disparities = 96;
+  params.downscale = 2;
+  std::vector<rtfuse::apps::StereoCloud> clouds;
+  ASSERT_TRUE(rtfuse::apps::stereo_clouds(seq, seq.ground_truth, {11, 14, 17}, params, &clouds, &error)) << error;
+  Maps m(0.1);
+  for (const auto& cloud : clouds) {
+    EXPECT_GT(cloud.points.size(), 50000u);
+    m.insert(cloud.points, cloud.origin, 15.0);
+  }
+  expect_equal(m);
 }
 
 }  // namespace octomap_equality_test
