@@ -141,6 +141,7 @@ CameraWorld::CameraWorld(const CameraWorldConfig& config) : config_(config) {
     add_surface(w, 1 + static_cast<std::uint64_t>(i), 128);
   }
   add_boxes();
+  add_obstacles();
 }
 
 void CameraWorld::add_surface(WorldSurface s, std::uint64_t texture_stream, int max_scale_texels) {
@@ -158,6 +159,73 @@ void CameraWorld::add_surface(WorldSurface s, std::uint64_t texture_stream, int 
     s.texture = static_cast<int>(textures_.size()) - 1;
   }
   surfaces_.push_back(s);
+}
+
+void CameraWorld::add_box(const Eigen::Vector3d& centre, const Eigen::Vector3d& ex, double a, double b,
+                          double height, std::uint64_t texture_stream) {
+  const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
+  const Eigen::Vector3d ey = ez.cross(ex);
+  struct Face {
+    Eigen::Vector3d origin, u, v;
+    double su, sv;
+  };
+  const Face faces[5] = {
+      {centre + a * ex - b * ey, ey, ez, 2.0 * b, height},
+      {centre - a * ex + b * ey, -ey, ez, 2.0 * b, height},
+      {centre + a * ex + b * ey, -ex, ez, 2.0 * a, height},
+      {centre - a * ex - b * ey, ex, ez, 2.0 * a, height},
+      {centre - a * ex - b * ey + height * ez, ex, ey, 2.0 * a, 2.0 * b},
+  };
+  for (int f = 0; f < 5; ++f) {
+    WorldSurface w;
+    w.kind = SurfaceKind::kBox;
+    w.origin = faces[f].origin;
+    w.axis_u = faces[f].u;
+    w.axis_v = faces[f].v;
+    w.size_u = faces[f].su;
+    w.size_v = faces[f].sv;
+    w.texel_m = kBoxTexelM;
+    add_surface(w, texture_stream + static_cast<std::uint64_t>(f), 64);
+  }
+  solids_.push_back(Solid{centre, ex, a, b, height});
+}
+
+void CameraWorld::add_obstacles() {
+  // After everything else, with texture streams of their own: a world
+  // without obstacles is byte for byte the world it was before they existed.
+  const int room = (kMaxSurfaces - static_cast<int>(surfaces_.size())) / 5;
+  const int n = std::min({static_cast<int>(config_.obstacles.size()), CameraWorldConfig::kMaxObstacles, room});
+  for (int i = 0; i < n; ++i) {
+    const ObstacleBox& o = config_.obstacles[static_cast<std::size_t>(i)];
+    add_box(Eigen::Vector3d(o.x, o.y, 0.0), Eigen::Vector3d::UnitX(), 0.5 * o.size_x, 0.5 * o.size_y, o.height,
+            1024 + static_cast<std::uint64_t>(i) * 5);
+  }
+}
+
+bool CameraWorld::solid_in(double x0, double y0, double x1, double y1, double z0, double z1) const noexcept {
+  if (z1 < 0.0) return false;
+  // Behind a wall (up to its height) is solid.
+  if (z0 < config_.wall_height_m &&
+      (x0 < wall_min_x() || x1 > wall_max_x() || y0 < wall_min_y() || y1 > wall_max_y())) {
+    return true;
+  }
+  // A box against the cell: separated along one of the four axes (x, y and
+  // the box's own two) or overlapping.
+  const double cx = 0.5 * (x0 + x1), cy = 0.5 * (y0 + y1);
+  const double hx = 0.5 * (x1 - x0), hy = 0.5 * (y1 - y0);
+  for (const Solid& b : solids_) {
+    if (z0 >= b.height) continue;
+    const double ux = b.ex.x(), uy = b.ex.y();  // box axis u; v = (-uy, ux)
+    const double dx = b.centre.x() - cx, dy = b.centre.y() - cy;
+    const double box_x = b.a * std::abs(ux) + b.b * std::abs(uy);  // the box's half extent along x
+    const double box_y = b.a * std::abs(uy) + b.b * std::abs(ux);
+    if (std::abs(dx) >= hx + box_x || std::abs(dy) >= hy + box_y) continue;
+    const double cell_u = hx * std::abs(ux) + hy * std::abs(uy);
+    const double cell_v = hx * std::abs(uy) + hy * std::abs(ux);
+    if (std::abs(dx * ux + dy * uy) >= b.a + cell_u || std::abs(-dx * uy + dy * ux) >= b.b + cell_v) continue;
+    return true;
+  }
+  return false;
 }
 
 void CameraWorld::add_boxes() {
@@ -222,32 +290,8 @@ void CameraWorld::add_boxes() {
       placed[box_count_][1] = cy;
       placed[box_count_][2] = radius;
 
-      const Eigen::Vector3d centre(cx, cy, 0.0);
-      const Eigen::Vector3d ex(c, s, 0.0);
-      const Eigen::Vector3d ey(-s, c, 0.0);
-      const Eigen::Vector3d ez = Eigen::Vector3d::UnitZ();
-      struct Face {
-        Eigen::Vector3d origin, u, v;
-        double su, sv;
-      };
-      const Face faces[5] = {
-          {centre + a * ex - b * ey, ey, ez, 2.0 * b, height},
-          {centre - a * ex + b * ey, -ey, ez, 2.0 * b, height},
-          {centre + a * ex + b * ey, -ex, ez, 2.0 * a, height},
-          {centre - a * ex - b * ey, ex, ez, 2.0 * a, height},
-          {centre - a * ex - b * ey + height * ez, ex, ey, 2.0 * a, 2.0 * b},
-      };
-      for (int f = 0; f < 5; ++f) {
-        WorldSurface w;
-        w.kind = SurfaceKind::kBox;
-        w.origin = faces[f].origin;
-        w.axis_u = faces[f].u;
-        w.axis_v = faces[f].v;
-        w.size_u = faces[f].su;
-        w.size_v = faces[f].sv;
-        w.texel_m = kBoxTexelM;
-        add_surface(w, 16 + static_cast<std::uint64_t>(box_count_) * 5 + static_cast<std::uint64_t>(f), 64);
-      }
+      add_box(Eigen::Vector3d(cx, cy, 0.0), Eigen::Vector3d(c, s, 0.0), a, b, height,
+              16 + static_cast<std::uint64_t>(box_count_) * 5);
       ++box_count_;
       break;
     }

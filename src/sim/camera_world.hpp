@@ -7,7 +7,11 @@
 // Frames: the world is the simulator's odom frame (z up; a drive starts at
 // the origin facing +x). The default free area holds every drive of
 // config/scenarios with at least 1.5 m to spare (their union spans x in
-// [-4.5, 16.9], y in [-4.8, 17.2]); nothing stands inside it.
+// [-4.5, 16.9], y in [-4.8, 17.2]); nothing stands inside it but the
+// obstacles a scenario places there (pillars, boxes, the two sides of a
+// narrow passage: [[obstacle]] in the scenario, for the mapper to find).
+// The world knows where it is solid (solid_in), so a map can be scored
+// against the truth.
 //
 // Texture is what a feature detector at VGA needs: high contrast at every
 // scale and nothing periodic. Each surface gets its own image, a "dead
@@ -27,10 +31,12 @@
 #include <Eigen/Geometry>
 
 #include "sim/mip_texture.hpp"
+#include "sim/obstacle_box.hpp"
 
 namespace rtfuse::sim {
 
 enum class WallSide : std::uint8_t { kMinX, kMaxX, kMinY, kMaxY };
+
 
 struct CameraWorldConfig {
   std::uint64_t seed = 1;
@@ -45,6 +51,10 @@ struct CameraWorldConfig {
   // it, a camera sees nothing to track but the boxes before it). The
   // default is on the robot's right at the start of every drive.
   WallSide plain_wall = WallSide::kMinY;
+  // Solids inside the free area (a scenario's [[obstacle]]s), at most
+  // kMaxObstacles: after the floor, the walls and the boxes, five faces each.
+  std::vector<ObstacleBox> obstacles;
+  static constexpr int kMaxObstacles = 12;
 };
 
 enum class SurfaceKind : std::uint8_t { kGround, kWall, kPlainWall, kBox };
@@ -77,6 +87,11 @@ class CameraWorld {
   const WorldSurface& surface(int i) const noexcept { return surfaces_[static_cast<std::size_t>(i)]; }
   const MipTexture& texture(int i) const noexcept { return textures_[static_cast<std::size_t>(i)]; }
   int box_count() const noexcept { return box_count_; }
+  // Whether anything solid (a box, an obstacle, the space behind a wall)
+  // overlaps the box [x0, x1] x [y0, y1] x [z0, z1]: the truth a map's cell
+  // is scored against.
+  bool solid_in(double x0, double y0, double x1, double y1, double z0, double z1) const noexcept;
+
   // The walls' inner faces: the free area grown by the margin.
   double wall_min_x() const noexcept { return config_.min_x - config_.wall_margin_m; }
   double wall_max_x() const noexcept { return config_.max_x + config_.wall_margin_m; }
@@ -100,11 +115,23 @@ class CameraWorld {
  private:
   void add_surface(WorldSurface s, std::uint64_t texture_stream, int max_scale_texels);
   void add_boxes();
+  void add_obstacles();
+  // A box of four sides and a top: centre on the floor, unit axes ex and
+  // ey (ey = z x ex), half sizes a and b; its faces' textures are streams
+  // texture_stream .. texture_stream + 4.
+  void add_box(const Eigen::Vector3d& centre, const Eigen::Vector3d& ex, double a, double b, double height,
+               std::uint64_t texture_stream);
+
+  struct Solid {
+    Eigen::Vector3d centre, ex;
+    double a, b, height;
+  };
 
   CameraWorldConfig config_;
   std::vector<WorldSurface> surfaces_;
   std::vector<MipTexture> textures_;
   int box_count_ = 0;
+  std::vector<Solid> solids_;  // boxes and obstacles, for solid_in()
   float far_ground_luma_ = 0.0f;
 };
 

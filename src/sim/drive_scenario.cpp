@@ -8,6 +8,7 @@
 #include <optional>
 
 #include "runtime/config/toml_reader.hpp"
+#include "sim/camera_world.hpp"
 #include "sim/path_plan.hpp"
 #include "core/physical_constants.hpp"
 
@@ -313,6 +314,52 @@ void read_dropouts(const Section& root, DriveScenario& sc) {
   });
 }
 
+// --- [[obstacle]] --------------------------------------------------------------
+
+void read_obstacles(const Section& root, DriveScenario& sc, std::vector<toml::source_region>& where) {
+  const CameraWorldConfig world;  // the free area obstacles stand in
+  config::for_each_table(root, "obstacle", CameraWorldConfig::kMaxObstacles, [&](const Section& s, bool fits) {
+    s.reject_unknown({"x_m", "y_m", "size_x_m", "size_y_m", "height_m"});
+    s.require({"x_m", "y_m", "size_x_m", "size_y_m"});
+    ObstacleBox o;
+    const auto coordinate = [](double v) { return v >= -1000.0 && v <= 1000.0; };
+    read_number(s, "x_m", o.x, coordinate, "must be within -1000..1000 m");
+    read_number(s, "y_m", o.y, coordinate, "must be within -1000..1000 m");
+    read_number(s, "size_x_m", o.size_x, in_range(0.0, 20.0), "must be > 0 and <= 20 m");
+    read_number(s, "size_y_m", o.size_y, in_range(0.0, 20.0), "must be > 0 and <= 20 m");
+    read_number(s, "height_m", o.height, in_range(0.0, 5.0), "must be > 0 and <= 5 m");
+    if (o.x - 0.5 * o.size_x < world.min_x || o.x + 0.5 * o.size_x > world.max_x ||
+        o.y - 0.5 * o.size_y < world.min_y || o.y + 0.5 * o.size_y > world.max_y) {
+      s.key_error("x_m", "the obstacle must stand inside the drive area, x " + fmt(world.min_x) + ".." +
+                             fmt(world.max_x) + " m, y " + fmt(world.min_y) + ".." + fmt(world.max_y) + " m");
+    }
+    where.push_back(s.key_where("x_m"));
+    if (fits) sc.obstacles.push_back(o);
+  });
+}
+
+// The path keeps half the track and 10 cm from every obstacle: a scripted
+// drive through a wall would make the camera see the inside of a box.
+void check_clearance(const DriveScenario& sc, const PathPlan& plan, const std::vector<toml::source_region>& where,
+                     Diagnostics& diag) {
+  const double need = 0.5 * sc.robot.track_width_m + 0.1;
+  for (std::size_t i = 0; i < sc.obstacles.size(); ++i) {
+    const ObstacleBox& o = sc.obstacles[i];
+    for (double t = 0.0; t <= plan.end_time() + 0.02; t += 0.02) {
+      const PathPoint p = plan.at(t);
+      const double dx = std::max(std::abs(p.x - o.x) - 0.5 * o.size_x, 0.0);
+      const double dy = std::max(std::abs(p.y - o.y) - 0.5 * o.size_y, 0.0);
+      if (dx * dx + dy * dy < need * need) {
+        diag.add(where[i], "obstacle[" + std::to_string(i) + "]",
+                 "the path passes " + fmt(std::sqrt(dx * dx + dy * dy)) + " m from this obstacle at t = " +
+                     fmt(std::floor(t * 10.0) / 10.0) + " s (x " + fmt(p.x) + ", y " + fmt(p.y) +
+                     "); the robot needs " + fmt(need) + " m (half its track and 0.1 m)");
+        break;
+      }
+    }
+  }
+}
+
 // --- [imu] --------------------------------------------------------------------
 
 void read_triple(const Section& s, std::string_view k, double scale, std::array<double, 3>& out) {
@@ -404,8 +451,9 @@ void read_gnss(const Section& s, SimGnssConfig& g) {
 
 // --- root -------------------------------------------------------------------
 
-void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_region>& path_where) {
-  root.reject_unknown({"duration_s", "seed", "limits", "path", "robot", "slip", "dropout", "imu", "gnss"});
+void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_region>& path_where,
+               std::vector<toml::source_region>& obstacle_where) {
+  root.reject_unknown({"duration_s", "seed", "limits", "path", "robot", "slip", "dropout", "imu", "gnss", "obstacle"});
   Diagnostics& d = root.diag();
   read_number(root, "duration_s", sc.duration_s, in_range(0.0, 86400.0),
               "must be > 0 and <= 86400 s (leave it out to run as long as the path takes)");
@@ -435,6 +483,7 @@ void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_
   read_dropouts(root, sc);
   read_imu(Section(config::section_table(root, "imu"), "imu", d), sc.imu);
   if (const toml::table* gnss = config::section_table(root, "gnss")) read_gnss(Section(gnss, "gnss", d), sc.gnss);
+  read_obstacles(root, sc, obstacle_where);
 }
 
 }  // namespace
@@ -457,8 +506,8 @@ bool load_drive_scenario_string(std::string_view toml_text, const std::string& s
   sc.source = source_name;
   if (const std::optional<toml::table> root = config::parse(toml_text, source_name, diag)) {
     const Section top(&*root, "", diag);
-    std::vector<toml::source_region> path_where;
-    read_root(top, sc, path_where);
+    std::vector<toml::source_region> path_where, obstacle_where;
+    read_root(top, sc, path_where, obstacle_where);
     if (diag.empty()) {
       // The drive itself: can every segment be driven within the limits, and
       // do the run's timed events fall inside it?
@@ -480,6 +529,7 @@ bool load_drive_scenario_string(std::string_view toml_text, const std::string& s
         if (sc.duration_s <= 0.0 && plan.end_time() <= 0.0) {
           top.table_error("duration_s", "the path is empty: give a duration_s for the robot to stand still");
         }
+        check_clearance(sc, plan, obstacle_where, diag);
       }
     }
   }

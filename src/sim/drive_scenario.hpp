@@ -16,6 +16,7 @@
 #include "core/time.hpp"
 #include "drivers/wheel/drive_kinematics.hpp"
 #include "sim/devices/mpu_register_file.hpp"
+#include "sim/obstacle_box.hpp"
 
 namespace rtfuse::sim {
 
@@ -153,6 +154,8 @@ struct DriveScenario {
   std::array<EncoderDropout, kMaxDropouts> dropouts{};
   SimImuConfig imu;
   SimGnssConfig gnss;
+  // [[obstacle]]: solids inside the drive area; the path keeps its distance.
+  std::vector<ObstacleBox> obstacles;
 };
 
 // Reads and validates a scenario. On failure returns false and sets *error

@@ -9,7 +9,8 @@
 namespace rtfuse::sim {
 
 std::unique_ptr<SimCamera> SimCamera::create(const RuntimeConfig& cfg, const TruthTrajectory& truth,
-                                             hal::Clock& clock, TimeNs t0, std::uint64_t seed, std::string* error) {
+                                             hal::Clock& clock, TimeNs t0, std::uint64_t seed,
+                                             const std::vector<ObstacleBox>& obstacles, std::string* error) {
   const CameraSection& c = cfg.hardware.camera;
   drivers::CameraMode mode;
   if (!drivers::find_camera_mode(c.resolution.view(), c.fps, &mode, error)) return nullptr;
@@ -44,6 +45,7 @@ std::unique_ptr<SimCamera> SimCamera::create(const RuntimeConfig& cfg, const Tru
   s->base_T_camera_ = *mount;
   CameraWorldConfig world;
   world.seed = seed;
+  world.obstacles = obstacles;
   s->world_ = std::make_unique<CameraWorld>(world);
   StereoRendererOptions options;
   options.noise_seed = seed;
@@ -83,7 +85,7 @@ void SimCamera::provide(DeviceBuses& out, hal::Clock& clock) noexcept {
 }
 
 std::unique_ptr<SimDevice> make_sim_camera(const SimDeviceContext& ctx, std::string* error) {
-  return SimCamera::create(ctx.cfg, ctx.truth, ctx.clock, ctx.t0, ctx.scenario.seed, error);
+  return SimCamera::create(ctx.cfg, ctx.truth, ctx.clock, ctx.t0, ctx.scenario.seed, ctx.scenario.obstacles, error);
 }
 
 }  // namespace rtfuse::sim

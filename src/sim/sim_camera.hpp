@@ -6,6 +6,7 @@
 // camera driver runs on it as on a real camera.
 #include <cstdint>
 #include <memory>
+#include <vector>
 #include <string>
 
 #include "drivers/camera/stereo_calibration.hpp"
@@ -28,9 +29,11 @@ std::unique_ptr<SimDevice> make_sim_camera(const SimDeviceContext& ctx, std::str
 class SimCamera final : public hal::mock::FrameGenerator, public SimDevice {
  public:
   // The camera section's calibration file and mode, the mount from the
-  // config's static transforms. Null with *error when they do not fit.
+  // config's static transforms, the scenario's obstacles in its world.
+  // Null with *error when they do not fit.
   static std::unique_ptr<SimCamera> create(const RuntimeConfig& cfg, const TruthTrajectory& truth, hal::Clock& clock,
-                                           TimeNs t0, std::uint64_t seed, std::string* error);
+                                           TimeNs t0, std::uint64_t seed, const std::vector<ObstacleBox>& obstacles,
+                                           std::string* error);
 
   hal::VideoStream& stream() { return *stream_; }
   // Fault injection (unplug, refused reopens): drive it from the camera's thread.

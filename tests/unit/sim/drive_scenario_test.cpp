@@ -37,7 +37,7 @@ DriveScenario load_ok(const std::string& text) {
 }
 
 TEST(DriveScenario, ShippedScenariosLoadAndCanBeDriven) {
-  for (const char* name : {"straight", "turns", "figure_eight", "slip", "dropout", "demo", "gnss_loop"}) {
+  for (const char* name : {"straight", "turns", "figure_eight", "slip", "dropout", "demo", "gnss_loop", "obstacles"}) {
     const std::string path = std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/" + name + ".toml";
     DriveScenario sc;
     std::string error;
