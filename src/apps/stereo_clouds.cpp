@@ -5,6 +5,7 @@
 
 #include "apps/grey_png.hpp"
 #include "vision/semi_global_matcher.hpp"
+#include "vision/texture_filter.hpp"
 
 namespace rtfuse::apps {
 
@@ -12,6 +13,7 @@ bool stereo_clouds(const KittiSequence& seq, const std::vector<Eigen::Matrix4d>&
                    const vision::DisparityParams& params, std::vector<StereoCloud>* out, std::string* error) {
   out->clear();
   std::unique_ptr<vision::SemiGlobalMatcher> matcher;
+  std::unique_ptr<vision::TextureFilter> texture;
   GreyPng left, right;
   std::vector<std::uint16_t> disparity;
   for (const int k : frames) {
@@ -30,6 +32,7 @@ bool stereo_clouds(const KittiSequence& seq, const std::vector<Eigen::Matrix4d>&
         *error = std::string("disparity: ") + matcher->error();
         return false;
       }
+      texture = std::make_unique<vision::TextureFilter>(left.width, left.height);
     }
     const int w = matcher->output_width(left.width), h = matcher->output_height(left.height);
     disparity.assign(static_cast<std::size_t>(w) * static_cast<std::size_t>(h), 0);
@@ -39,11 +42,14 @@ bool stereo_clouds(const KittiSequence& seq, const std::vector<Eigen::Matrix4d>&
                                                             {right.pixels.data(), right.width, right.height,
                                                              right.width},
                                                             image);
-    const auto t1 = std::chrono::steady_clock::now();
     if (status != vision::DisparityStatus::kOk) {
       *error = seq.left[k] + ": disparity: " + vision::to_string(status);
       return false;
     }
+    // Blank regions (sky, plain walls) matched by guesswork would put
+    // phantom obstacles in the map.
+    texture->apply({left.pixels.data(), left.width, left.height, left.width}, params.downscale, image);
+    const auto t1 = std::chrono::steady_clock::now();
     StereoCloud cloud;
     cloud.frame = k;
     cloud.disparity_ms = std::chrono::duration<double, std::milli>(t1 - t0).count();

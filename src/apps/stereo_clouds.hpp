@@ -1,6 +1,7 @@
 #pragma once
 // Point clouds from a KITTI-layout folder of rectified pairs: each chosen
-// frame's dense disparity (the runtime's matcher), back-projected and
+// frame's dense disparity (the runtime's matcher, textureless pixels taken
+// back: vision/texture_filter.hpp), back-projected and
 // carried into the first camera's frame by a pose per frame (the ground
 // truth, or the visual odometry's). What rtfuse-map maps offline and what
 // the OctoMap reference test inserts into both maps. Allocates, reads files.
@@ -21,7 +22,7 @@ struct StereoCloud {
   mapping::MapPoint origin;  // the left camera's centre
   std::vector<mapping::MapPoint> points;
   mapping::DisparityPointCounts counts;
-  double disparity_ms = 0.0;
+  double disparity_ms = 0.0;  // matching and the texture filter
 };
 
 // Frames `frames` of seq with poses[frame] (left camera k in camera 0's

@@ -161,7 +161,7 @@ TEST(OctomapEquality, KittiStereoWithGroundTruthPoses) {
   ASSERT_TRUE(rtfuse::apps::stereo_clouds(seq, seq.ground_truth, {11, 14, 17}, params, &clouds, &error)) << error;
   Maps m(0.1);
   for (const auto& cloud : clouds) {
-    EXPECT_GT(cloud.points.size(), 50000u);
+    EXPECT_GT(cloud.points.size(), 40000u);  // of 113k pixels: sky and blank road dropped
     m.insert(cloud.points, cloud.origin, 15.0);
   }
   expect_equal(m);
