@@ -1,6 +1,7 @@
 // OctoMap's update rules on scans small enough to follow by hand, and the
 // fixed pool: what a full one does, and that nothing is allocated.
 #include "mapping/occupancy_map.hpp"
+#include "mapping/map_digest.hpp"
 
 #include <gtest/gtest.h>
 
@@ -201,6 +202,43 @@ TEST(OccupancyMap, DefaultsAreOctomapsLogOdds) {
   EXPECT_EQ(lo.clamp_min, -2.00002789f);
   EXPECT_EQ(lo.clamp_max, 3.51103067f);
   EXPECT_EQ(lo.occupied, 0.0f);
+}
+
+}  // namespace occupancy_map_test
+
+namespace occupancy_map_test {
+
+// The same bits on every machine: a cloud made with integer hashing and
+// float + - * / only, three scans from three origins with a range limit,
+// and the map's digest and its .bt's size against the values this build
+// gives on x86-64. The aarch64 stage (tools/test-cross.sh) runs this test
+// under emulation: a different float rounding anywhere in the ray or the
+// sums (a contracted multiply-add, a library's sqrt) changes the digest.
+TEST(OccupancyMap, TheSameCloudGivesTheSameBitsOnEveryMachine) {
+  std::uint64_t state = 0x9E3779B97F4A7C15ull;
+  const auto next = [&] {
+    state = state * 6364136223846793005ull + 1442695040888963407ull;
+    return static_cast<float>(state >> 40) / static_cast<float>(1u << 24);  // [0, 1)
+  };
+  std::vector<MapPoint> cloud;
+  for (int i = 0; i < 20000; ++i) {
+    // Points on the walls and floor of a 10 x 8 x 3 m room, jittered.
+    const float a = next(), b = next(), c = next();
+    switch (i % 5) {
+      case 0: cloud.push_back({-5.0f + 10.0f * a, -4.0f + 0.02f * c, 3.0f * b}); break;
+      case 1: cloud.push_back({-5.0f + 10.0f * a, 4.0f - 0.02f * c, 3.0f * b}); break;
+      case 2: cloud.push_back({5.0f - 0.02f * c, -4.0f + 8.0f * a, 3.0f * b}); break;
+      case 3: cloud.push_back({-5.0f + 0.02f * c, -4.0f + 8.0f * a, 3.0f * b}); break;
+      default: cloud.push_back({-5.0f + 10.0f * a, -4.0f + 8.0f * b, 0.01f * c}); break;
+    }
+  }
+  OccupancyMap map(params(0.05), {8192, 65536});
+  map.insert_scan(cloud.data(), cloud.size(), {0.013f, -0.021f, 1.2f}, -1.0);
+  map.insert_scan(cloud.data(), cloud.size() / 2, {1.51f, 0.77f, 1.0f}, 4.0);
+  map.insert_scan(cloud.data() + 1000, cloud.size() - 1000, {-2.2f, 1.3f, 0.5f}, 6.5);
+  EXPECT_EQ(map.known_voxels(), 1317585u);
+  EXPECT_EQ(map.occupied_voxels(), 17032u);
+  EXPECT_EQ(map_digest(map), 0xa72f5d04ed728da1ull);
 }
 
 }  // namespace occupancy_map_test
