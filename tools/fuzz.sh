@@ -33,7 +33,7 @@ while (($#)); do
     *) harnesses+=("$1"); shift ;;
   esac
 done
-all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss point_cloud daemon_input)
+all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss point_cloud octomap_binary daemon_input)
 ((${#harnesses[@]})) || harnesses=("${all[@]}")
 
 "$root/tools/setup-deps.sh"
@@ -66,6 +66,12 @@ fi
 if [[ -f "$data/octomap/scan.dat.bz2" ]]; then
   { bzip2 -dc "$data/octomap/scan.dat.bz2" || true; } | head -n 300 >"$seeds/point_cloud/scan300.xyz"
 fi
+# .bt files: one occupied voxel (a path of inner nodes), a coarse free
+# leaf; and OctoMap's own example map where Debian installs it.
+{ printf '# Octomap OcTree binary file\nid OcTree\nsize 17\nres 0.1\ndata\n\x00\xc0'
+  for _ in $(seq 14); do printf '\x03\x00'; done; printf '\x02\x00'; } >"$seeds/octomap_binary/voxel.bt"
+{ printf '# Octomap OcTree binary file\nid OcTree\nsize 11\nres 0.1\ndata\n\x00\xc0'
+  for _ in $(seq 8); do printf '\x03\x00'; done; printf '\x01\x00'; } >"$seeds/octomap_binary/coarse.bt"
 printf '# a comment, a blank line, signs and exponents\n\n+1.5 -2e-1 0.25\n 3 4 5 \n' >"$seeds/point_cloud/small.xyz"
 "$dir/tests/fuzz/make_seeds" "$seeds" >/dev/null
 for h in "${all[@]}"; do

@@ -12,6 +12,9 @@
 //                                       truth, or e.g. rtfuse-vo's --out),
 //                                       in a z-up frame (x forward, y left)
 //                                       with the first camera at the origin
+//   --bt MAP.bt                         a map OctoMap (or this tool) wrote:
+//                                       read, then written out again and
+//                                       projected like the others
 //
 // The last stdout line is a JSON object: points, times, known and occupied
 // voxels, memory_bytes (the map's bytes in use, comparable with OctoMap's
@@ -27,6 +30,7 @@
 #include <cstdio>
 #include <cstring>
 #include <fstream>
+#include <iterator>
 #include <stdexcept>
 #include <string>
 #include <vector>
@@ -39,6 +43,7 @@
 #include "mapping/map_digest.hpp"
 #include "mapping/map_server_files.hpp"
 #include "mapping/octomap_binary.hpp"
+#include "mapping/octomap_binary_reader.hpp"
 #include "mapping/occupancy_map.hpp"
 
 namespace {
@@ -104,7 +109,7 @@ struct Scan {
 
 int main(int argc, char** argv) {
   CLI::App app{"rtfuse-map: an occupancy map (OctoMap's semantics) built offline, written as .bt"};
-  std::string cloud_path, origin_text = "0,0,0", kitti_dir, poses_path, out_path, grid_prefix, png_path;
+  std::string cloud_path, origin_text = "0,0,0", kitti_dir, poses_path, bt_path, out_path, grid_prefix, png_path;
   double resolution = 0.05, max_range = -1.0, z_min = -0.5, z_max = 2.0;
   int repeat = 1, first = 0, last = -1, every = 1, disparities = 96, downscale = 2;
   std::size_t pool_mib = 512;
@@ -122,7 +127,9 @@ int main(int argc, char** argv) {
   app.add_option("--every", every, "--kitti: every n-th frame (keyframes)")->check(CLI::Range(1, 100000));
   app.add_option("--disparities", disparities, "--kitti: disparities searched (a multiple of 16 x downscale)");
   app.add_option("--downscale", downscale, "--kitti: 1 full resolution, 2 half (the live default)");
+  auto* bt_opt = app.add_option("--bt", bt_path, "an OctoMap binary tree (.bt): read, rewritten, projected");
   cloud_opt->excludes(kitti_opt);
+  bt_opt->excludes(cloud_opt)->excludes(kitti_opt);
   app.add_option("--resolution", resolution, "voxel edge (metres)");
   app.add_option("--max-range", max_range,
                  "rays longer than this free up to it and mark nothing (metres; negative: no limit)");
@@ -135,9 +142,27 @@ int main(int argc, char** argv) {
   app.add_option("--z-max", z_max, "the grid's highest voxel centres (metres)");
   try {
     app.parse(argc, argv);
-    if (cloud_path.empty() && kitti_dir.empty()) throw CLI::RequiredError("--cloud or --kitti");
+    if (cloud_path.empty() && kitti_dir.empty() && bt_path.empty()) {
+      throw CLI::RequiredError("--cloud, --kitti or --bt");
+    }
   } catch (const CLI::ParseError& e) {
     return app.exit(e) == 0 ? 0 : 2;
+  }
+  std::vector<std::uint8_t> bt_bytes;
+  if (!bt_path.empty()) {
+    std::ifstream in(bt_path, std::ios::binary);
+    if (!in) {
+      std::fprintf(stderr, "rtfuse-map: %s: cannot open: %s\n", bt_path.c_str(), std::strerror(errno));
+      return 1;
+    }
+    bt_bytes.assign(std::istreambuf_iterator<char>(in), std::istreambuf_iterator<char>());
+    OctomapBinaryHeader header;
+    std::string error;
+    if (!read_octomap_binary_header(bt_bytes.data(), bt_bytes.size(), bt_path, &header, &error)) {
+      std::fprintf(stderr, "rtfuse-map: %s\n", error.c_str());
+      return 1;
+    }
+    resolution = header.resolution;  // the file's
   }
   OccupancyParams params;
   params.resolution = resolution;
@@ -155,7 +180,9 @@ int main(int argc, char** argv) {
   std::vector<double> disparity_ms;
   std::vector<rtfuse::apps::DataPoint> path;
   std::string source;
-  if (!cloud_path.empty()) {
+  if (!bt_path.empty()) {
+    source = bt_path;
+  } else if (!cloud_path.empty()) {
     Scan scan;
     if (!parse_origin(origin_text, scan.origin)) {
       std::fprintf(stderr, "rtfuse-map: --origin \"%s\": expected three finite numbers X,Y,Z\n", origin_text.c_str());
@@ -231,7 +258,16 @@ int main(int argc, char** argv) {
   std::vector<double> insert_ms;
   ScanResult total;
   std::size_t points = 0;
-  for (int k = 0; k < (cloud_path.empty() ? 1 : repeat); ++k) {
+  if (!bt_bytes.empty()) {
+    std::string error;
+    const auto t0 = std::chrono::steady_clock::now();
+    if (!read_octomap_binary(bt_bytes.data(), bt_bytes.size(), bt_path, map, &error)) {
+      std::fprintf(stderr, "rtfuse-map: %s\n", error.c_str());
+      return error.find("cannot hold") != std::string::npos ? 3 : 1;
+    }
+    insert_ms.push_back(std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - t0).count());
+  }
+  for (int k = 0; k < (cloud_path.empty() ? 1 : repeat) && bt_bytes.empty(); ++k) {
     map.clear();
     total = ScanResult{};
     points = 0;
@@ -286,7 +322,11 @@ int main(int argc, char** argv) {
     figure.origin_y = oy;
     figure.path = path;
     figure.figures.push_back("# the map");
-    std::snprintf(line, sizeof line, "scans       %zu (%zu points)", scans.size(), points);
+    if (bt_bytes.empty()) {
+      std::snprintf(line, sizeof line, "scans       %zu (%zu points)", scans.size(), points);
+    } else {
+      std::snprintf(line, sizeof line, "read        %zu bytes of .bt", bt_bytes.size());
+    }
     figure.figures.push_back(line);
     char range[32] = "unlimited";
     if (max_range >= 0) std::snprintf(range, sizeof range, "%.1f m", max_range);
@@ -298,7 +338,8 @@ int main(int argc, char** argv) {
     figure.figures.push_back(line);
     std::snprintf(line, sizeof line, "memory      %.2f MB", map.store().bytes_used() / 1e6);
     figure.figures.push_back(line);
-    std::snprintf(line, sizeof line, "insert      %.1f ms/scan median", insert_median);
+    std::snprintf(line, sizeof line, bt_bytes.empty() ? "insert      %.1f ms/scan median" : "load        %.1f ms",
+                  insert_median);
     figure.figures.push_back(line);
     if (!disparity_ms.empty()) {
       std::snprintf(line, sizeof line, "disparity   %.1f ms/frame median", disparity_median);
@@ -336,7 +377,7 @@ int main(int argc, char** argv) {
       "\"memory_bytes\": %zu, \"pool_bytes\": %zu, \"bt\": \"%s\", \"bt_bytes\": %zu, \"bt_nodes\": %zu, "
       "\"digest\": \"%016" PRIx64 "\", \"grid_width\": %d, \"grid_height\": %d, \"grid_occupied\": %zu, "
       "\"grid_free\": %zu}\n",
-      cloud_path.empty() ? "kitti" : "cloud", source.c_str(), scans.size(), points, resolution, max_range,
+      !bt_path.empty() ? "bt" : cloud_path.empty() ? "kitti" : "cloud", source.c_str(), scans.size(), points, resolution, max_range,
       cloud_path.empty() ? 1 : repeat, insert_median, disparity_median, total.hits, total.frees, total.beyond_range,
       total.outside, total.rejected, map.known_voxels(), map.occupied_voxels(), total.dropped,
       map.store().bytes_used(), map.store().bytes_reserved(), out_path.c_str(), file.size(), nodes, map_digest(map),

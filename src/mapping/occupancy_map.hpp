@@ -87,6 +87,14 @@ class OccupancyMap {
   // Forgets every voxel and count (the pool stays).
   void clear() noexcept;
 
+  // Sets every voxel of the cube of 2^(16 - depth) voxels a side whose
+  // lowest corner is `corner` (aligned to the cube's size) to log_odds,
+  // known: how a map is loaded from a file of leaves (octomap_binary_reader).
+  // Whole sub-bricks take one slot, so a coarse leaf costs its bricks, not
+  // its voxels. False, with the map changed up to there and the shortfall
+  // counted in dropped_updates(), when the pool cannot hold it.
+  bool fill_cube(const VoxelKey& corner, int depth, float log_odds) noexcept;
+
   static float float_of(std::uint32_t bits) noexcept {
     float f;
     std::memcpy(&f, &bits, sizeof f);

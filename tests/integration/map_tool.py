@@ -3,14 +3,16 @@
 
   cloud   a synthetic room seen from its middle: the JSON's counts, a .bt
           with OctoMap's header and as many nodes as it says, map_server's
-          PGM + YAML, a PNG; a second run gives the same digest;
+          PGM + YAML, a PNG; a second run gives the same digest; the .bt
+          read back (--bt) holds the same voxels and writes the same bytes;
   kitti   the real KITTI 06 pairs with their ground truth (frames 11-20,
           every third): four scans, the map and the grid non-trivial, the
           same digest twice;
   bad     a missing cloud, a malformed line, a bad origin, a pool too small,
-          a KITTI folder without poses, a malformed poses file: each one
-          clear message (file and line where there is one) and its exit
-          status, never a crash.
+          a KITTI folder without poses, a malformed poses file, a .bt cut
+          short, of another tree type, not a .bt, too large for the pool:
+          each one clear message (file and line or byte where there is
+          one) and its exit status, never a crash.
 """
 import json
 import math
@@ -94,6 +96,15 @@ def check_cloud(tmp):
     again = summary(run(*args))
     if again["digest"] != s["digest"]:
         fail("digest %s then %s" % (s["digest"], again["digest"]))
+    # The .bt read back: the same voxels known and occupied, written again
+    # to the same bytes.
+    rewritten = os.path.join(tmp, "again.bt")
+    b = summary(run("--bt", out, "--out", rewritten))
+    if (b["mode"], b["known_voxels"], b["occupied_voxels"]) != ("bt", s["known_voxels"], s["occupied_voxels"]):
+        fail("read back: %s" % b)
+    with open(rewritten, "rb") as f:
+        if f.read() != bt:
+            fail("the .bt written back differs")
     print("cloud: %d points, %d known, %d occupied, %.1f ms, digest %s" %
           (s["points"], s["known_voxels"], s["occupied_voxels"], s["ms_median"], s["digest"]))
 
@@ -150,6 +161,19 @@ def check_bad(tmp):
     expect(run("--cloud", good, "--resolution", "0", "--out", out), 2, "resolution")
     expect(run("--cloud", good, "--resolution", "0.02", "--pool-mib", "1", "--out", out), 3, "raise --pool-mib")
     expect(run("--cloud", good, "--out", os.path.join(tmp, "no", "dir", "x.bt")), 1, "cannot write")
+    good_bt = os.path.join(tmp, "good.bt")
+    summary(run("--cloud", good, "--resolution", "0.02", "--out", good_bt))
+    with open(good_bt, "rb") as f:
+        data = f.read()
+    cut = os.path.join(tmp, "cut.bt")
+    with open(cut, "wb") as f:
+        f.write(data[: len(data) - 7])
+    expect(run("--bt", cut, "--out", out), 1, cut + ": cut short at byte")
+    with open(cut, "wb") as f:
+        f.write(b"# Octomap OcTree binary file\nid ColorOcTree\nsize 1\nres 0.1\ndata\n\x00\x00")
+    expect(run("--bt", cut, "--out", out), 1, "only OcTree")
+    expect(run("--bt", good, "--out", out), 1, "not an OctoMap binary tree")
+    expect(run("--bt", good_bt, "--pool-mib", "1", "--out", out), 3, "cannot hold the file")
     if os.path.isdir(SEQ):
         nop = os.path.join(tmp, "nop")
         os.makedirs(nop)
