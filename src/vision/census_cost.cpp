@@ -5,9 +5,15 @@
 namespace rtfuse::vision {
 namespace {
 
+static_assert(kCensusPlanes == 4, "the cost loop counts four planes at once");
+
 template <class B>
-void cost_row(const std::uint8_t* const* left, const std::uint8_t* const* right_reversed, int width, int disparities,
+void cost_row(const std::uint8_t* const* left, const std::uint8_t* const* right_planes, int width, int disparities,
               std::uint8_t* cost) noexcept {
+  // Local copies: the cost stores could alias the caller's pointer array,
+  // which would reload every pointer at every step.
+  const std::uint8_t* right_reversed[kCensusPlanes];
+  for (int g = 0; g < kCensusPlanes; ++g) right_reversed[g] = right_planes[g];
   for (int x = 0; x < width; ++x) {
     typename B::V l[kCensusPlanes];
     for (int g = 0; g < kCensusPlanes; ++g) l[g] = B::splat(left[g][x]);
@@ -16,10 +22,9 @@ void cost_row(const std::uint8_t* const* left, const std::uint8_t* const* right_
     const int j0 = width - 1 - x;
     std::uint8_t* out = cost + static_cast<std::ptrdiff_t>(x) * disparities;
     for (int d = 0; d < disparities; d += 16) {
-      // The eight planes' counts add up to at most 62: no byte overflows.
-      typename B::V acc = B::xor_popcount(l[0], B::load(right_reversed[0] + j0 + d));
-      for (int g = 1; g < kCensusPlanes; ++g) acc = B::add(acc, B::xor_popcount(l[g], B::load(right_reversed[g] + j0 + d)));
-      B::store(out + d, acc);
+      B::store(out + d, B::xor_popcount4(l[0], B::load(right_reversed[0] + j0 + d), l[1],
+                                         B::load(right_reversed[1] + j0 + d), l[2], B::load(right_reversed[2] + j0 + d),
+                                         l[3], B::load(right_reversed[3] + j0 + d)));
     }
     for (int d = x + 1; d < disparities; ++d) out[d] = kOutsideCost;
   }

@@ -7,6 +7,7 @@
 #include "vision/census_transform.hpp"
 #include "vision/disparity_selection.hpp"
 #include "vision/feature_filters.hpp"
+#include "vision/packed_winner.hpp"
 #include "vision/simd_u8.hpp"
 
 namespace rtfuse::vision {
@@ -27,46 +28,105 @@ constexpr int kSlotFirst = 16;
 // costs and sums).
 constexpr long long kMaxCells = 1LL << 30;
 
-// One pixel of kN paths (kN even): their new costs from their previous
-// pixels' and the pixel's matching costs, sixteen disparities a step, added
-// into the pixel's 16-bit sums (written, in the first pass).
-template <class B, int kN, bool kFirst>
-inline void update_paths(const std::uint8_t* const* prev, std::uint8_t* const* cur, const std::uint8_t* cost,
-                         std::int16_t* sum, int disparities, typename B::V p1, int p2) noexcept {
+// One pixel of two paths: their new costs from their previous pixels' and
+// the pixel's matching costs, sixteen disparities a step; the two paths'
+// sum (bytes) goes to sink(k, sum of k..k+15). Two paths a sweep (a
+// pass's four take two sweeps): with more, their vectors no longer fit the
+// sixteen registers of SSE2 and spill.
+template <class B, bool kRowPath, class Sink>
+inline void update_path_pair(const std::uint8_t* const* prev, std::uint8_t* const* cur, const std::uint8_t* cost,
+                             int disparities, typename B::V p1, typename B::V jump, Sink&& sink) noexcept {
   using V = typename B::V;
-  using W = typename B::Wide;
-  V base[kN], jump[kN], least[kN];
-#pragma GCC unroll 4
-  for (int j = 0; j < kN; ++j) {
-    base[j] = B::splat(prev[j][0]);
-    jump[j] = B::splat(static_cast<std::uint8_t>(prev[j][0] + p2));
-    least[j] = B::splat(kPathBeyondRange);
-  }
+  // Every candidate is at least the previous least (base), so subtracting
+  // it first cannot wrap, and the jump is then the constant P2.
+  const V base[2] = {B::splat(prev[0][0]), B::splat(prev[1][0])};
+  V least[2] = {B::splat(kPathBeyondRange), B::splat(kPathBeyondRange)};
+  // The row path (path 0 if kRowPath): its previous pixel's costs were
+  // stored just now, and a load one byte off a recent store cannot be
+  // forwarded from the store buffer (a stall of every such load). Its
+  // neighbours d - 1 and d + 1 are therefore shifted in from the chunks on
+  // either side, loaded where they were stored.
+  V row_before = B::splat(kPathBeyondRange), row_at = B::load(prev[0] + kSlotFirst);
   for (int k = 0; k < disparities; k += 16) {
     const V c = B::load(cost + k);
-    typename W::V lo = kFirst ? W::splat(0) : W::load(sum + k);
-    typename W::V hi = kFirst ? W::splat(0) : W::load(sum + k + 8);
-    // Unrolled so that each path's vectors stay in registers.
-#pragma GCC unroll 4
-    for (int j = 0; j < kN; j += 2) {
-      V pair = B::splat(0);
+    // Past the range: the slot's beyond-range guard, not written since.
+    const V row_after = kRowPath ? B::load(prev[0] + kSlotFirst + k + 16) : row_at;
+    V pair = B::splat(0);
 #pragma GCC unroll 2
-      for (int i = j; i < j + 2; ++i) {
-        const std::uint8_t* p = prev[i] + kSlotFirst + k;
-        const V m =
-            B::min(B::min(B::load(p), B::adds(B::load(p - 1), p1)), B::min(B::adds(B::load(p + 1), p1), jump[i]));
-        const V l = B::add(B::sub(m, base[i]), c);
-        B::store(cur[i] + kSlotFirst + k, l);
-        least[i] = B::min(least[i], l);
-        pair = B::add(pair, l);
-      }
-      lo = W::add(lo, B::widen_lo(pair));
-      hi = W::add(hi, B::widen_hi(pair));
+    for (int i = 0; i < 2; ++i) {
+      const std::uint8_t* p = prev[i] + kSlotFirst + k;
+      const bool row = kRowPath && i == 0;
+      const V at = row ? row_at : B::load(p);
+      const V before = row ? B::shift_in_before(row_at, row_before) : B::load(p - 1);
+      const V after = row ? B::shift_in_after(row_at, row_after) : B::load(p + 1);
+      const V m = B::min(B::sub(B::min(B::min(at, B::adds(before, p1)), B::adds(after, p1)), base[i]), jump);
+      const V l = B::add(m, c);
+      B::store(cur[i] + kSlotFirst + k, l);
+      least[i] = B::min(least[i], l);
+      pair = B::add(pair, l);
     }
-    W::store(sum + k, lo);
-    W::store(sum + k + 8, hi);
+    sink(k, pair);
+    if (kRowPath) {
+      row_before = row_at;
+      row_at = row_after;
+    }
   }
-  for (int j = 0; j < kN; ++j) cur[j][0] = static_cast<std::uint8_t>(B::hmin(least[j]));
+  cur[0][0] = static_cast<std::uint8_t>(B::hmin(least[0]));
+  cur[1][0] = static_cast<std::uint8_t>(B::hmin(least[1]));
+}
+
+// The downward pass's kN paths (2 or 4, the row path first) of one pixel.
+// Two paths' sum fits a byte (at most 2 x 127), so with 4 paths in all
+// it waits for the upward pass as bytes (pair_sum), half the memory
+// traffic; four paths' sum needs the 16-bit sum.
+template <class B, int kN>
+inline void down_paths(const std::uint8_t* const* prev, std::uint8_t* const* cur, const std::uint8_t* cost,
+                       std::int16_t* sum, std::uint8_t* pair_sum, int disparities, typename B::V p1,
+                       typename B::V jump) noexcept {
+  using V = typename B::V;
+  using W = typename B::Wide;
+  if (kN == 2) {
+    update_path_pair<B, true>(prev, cur, cost, disparities, p1, jump, [pair_sum](int k, V pair) {
+      B::store(pair_sum + k, pair);
+    });
+    return;
+  }
+  update_path_pair<B, true>(prev, cur, cost, disparities, p1, jump, [sum](int k, V pair) {
+    W::store(sum + k, B::widen_lo(pair));
+    W::store(sum + k + 8, B::widen_hi(pair));
+  });
+  // Loaded at the addresses and sizes just stored: forwarded from the store
+  // buffer.
+  update_path_pair<B, false>(prev + 2, cur + 2, cost, disparities, p1, jump, [sum](int k, V pair) {
+    W::store(sum + k, W::add(W::load(sum + k), B::widen_lo(pair)));
+    W::store(sum + k + 8, W::add(W::load(sum + k + 8), B::widen_hi(pair)));
+  });
+}
+
+// The upward pass's kN paths of one pixel, added to the downward pass's
+// sums (pair_sum with 2 paths a pass, sum with 4) into out.
+template <class B, int kN>
+inline void up_paths(const std::uint8_t* const* prev, std::uint8_t* const* cur, const std::uint8_t* cost,
+                     const std::int16_t* sum, const std::uint8_t* pair_sum, std::int16_t* out, int disparities,
+                     typename B::V p1, typename B::V jump) noexcept {
+  using V = typename B::V;
+  using W = typename B::Wide;
+  if (kN == 2) {
+    update_path_pair<B, true>(prev, cur, cost, disparities, p1, jump, [pair_sum, out](int k, V pair) {
+      const V down = B::load(pair_sum + k);
+      W::store(out + k, W::add(B::widen_lo(down), B::widen_lo(pair)));
+      W::store(out + k + 8, W::add(B::widen_hi(down), B::widen_hi(pair)));
+    });
+    return;
+  }
+  update_path_pair<B, true>(prev, cur, cost, disparities, p1, jump, [sum, out](int k, V pair) {
+    W::store(out + k, W::add(W::load(sum + k), B::widen_lo(pair)));
+    W::store(out + k + 8, W::add(W::load(sum + k + 8), B::widen_hi(pair)));
+  });
+  update_path_pair<B, false>(prev + 2, cur + 2, cost, disparities, p1, jump, [out](int k, V pair) {
+    W::store(out + k, W::add(W::load(out + k), B::widen_lo(pair)));
+    W::store(out + k + 8, W::add(W::load(out + k + 8), B::widen_hi(pair)));
+  });
 }
 
 }  // namespace
@@ -102,6 +162,8 @@ struct SemiGlobalMatcher::Workspace {
         left_best(new std::int16_t[static_cast<std::size_t>(w)]()),
         right_best(new std::int16_t[static_cast<std::size_t>(w + d)]()),
         right_cost(new std::int16_t[static_cast<std::size_t>(w + d)]()),
+        total(new std::int16_t[static_cast<std::size_t>(d)]()),
+        row_sums(new std::int16_t[static_cast<std::size_t>(w) * static_cast<std::size_t>(d)]()),
         speckles(w * h) {
     if (halve) {
       half_left = Plane<std::uint8_t>(w, h);
@@ -140,6 +202,8 @@ struct SemiGlobalMatcher::Workspace {
   Plane<std::int16_t> disparity;  // matched pixels * kDisparityScale, -1 invalid
   std::unique_ptr<std::int16_t[]> left_best, right_best;
   std::unique_ptr<std::int16_t[]> right_cost;
+  std::unique_ptr<std::int16_t[]> total;     // one pixel's complete sums (fused selection)
+  std::unique_ptr<std::int16_t[]> row_sums;  // one row's (two-pass selection)
   SpeckleFilter speckles;
 };
 
@@ -191,12 +255,14 @@ DisparityStatus SemiGlobalMatcher::compute(const GreyView& left, const GreyView&
   return DisparityStatus::kOk;
 }
 
-template <class B, int kPaths>
+template <class B, int kPaths, bool kFused>
 void SemiGlobalMatcher::aggregate(int w, int h) noexcept {
   constexpr int kN = kPaths / 2;  // paths per pass
+  using W = typename B::Wide;
   Workspace& ws = *ws_;
-  const int d = disparities_, slot = ws.slot, p2 = params_.p2;
+  const int d = disparities_, slot = ws.slot;
   const typename B::V p1 = B::splat(static_cast<std::uint8_t>(params_.p1));
+  const typename B::V jump = B::splat(static_cast<std::uint8_t>(params_.p2));
   const std::ptrdiff_t pixel = d, row_cells = static_cast<std::ptrdiff_t>(w) * d;
   // Direction j of a pass: 0 along the row, 1 along the column, 2 and 3
   // the diagonals; the column and diagonal paths keep their previous row.
@@ -206,11 +272,17 @@ void SemiGlobalMatcher::aggregate(int w, int h) noexcept {
 
   const std::uint8_t* prev[4];
   std::uint8_t* cur[4];
+  // With 4 paths the downward sums are bytes, in the first half of the
+  // 16-bit volume's memory.
+  std::uint8_t* pair_sums = reinterpret_cast<std::uint8_t*>(ws.sums.get());
 
-  // Down: from the left, from above, from above left and above right.
+  // Down: from the left, from above, from above left and above right. A
+  // row's costs are computed just before it, so the pass finds them in cache.
   for (int y = 0; y < h; ++y) {
+    census_costs(y, w);
     const std::uint8_t* cost = ws.cost.get() + y * row_cells;
     std::int16_t* sum = ws.sums.get() + y * row_cells;
+    std::uint8_t* pair_sum = pair_sums + y * row_cells;
     for (int x = 0; x < w; ++x) {
       prev[0] = x > 0 ? ws.horizontal[(x - 1) & 1] : ws.zero;
       cur[0] = ws.horizontal[x & 1];
@@ -222,17 +294,24 @@ void SemiGlobalMatcher::aggregate(int w, int h) noexcept {
         prev[3] = y > 0 && x + 1 < w ? at(prev_row[2], x + 1) : ws.zero;
         cur[3] = at(cur_row[2], x);
       }
-      update_paths<B, kN, true>(prev, cur, cost + x * pixel, sum + x * pixel, d, p1, p2);
+      down_paths<B, kN>(prev, cur, cost + x * pixel, sum + x * pixel, pair_sum + x * pixel, d, p1, jump);
     }
     std::swap(prev_row, cur_row);
   }
 
   // Up: from the right, from below, from below right and below left; each
-  // row's sums are then complete and its disparities are chosen.
+  // pixel's sums are then complete and its disparity is chosen (fused:
+  // from a one-pixel buffer in L1, packed_winner.hpp; else from the
+  // volume, row by row).
   const DisparityRowScratch scratch{ws.left_best.get(), ws.right_best.get(), ws.right_cost.get()};
+  std::int16_t* total = ws.total.get();
+  std::int16_t* row_sums = ws.row_sums.get();
   for (int y = h - 1; y >= 0; --y) {
     const std::uint8_t* cost = ws.cost.get() + y * row_cells;
-    std::int16_t* sum = ws.sums.get() + y * row_cells;
+    const std::int16_t* sum = ws.sums.get() + y * row_cells;
+    const std::uint8_t* pair_sum = pair_sums + y * row_cells;
+    std::int16_t* out = ws.disparity.row(y);
+    PackedWinner<W> winner(w, d, params_.uniqueness_percent, scratch.right_cost);
     for (int x = w - 1; x >= 0; --x) {
       prev[0] = x + 1 < w ? ws.horizontal[(x + 1) & 1] : ws.zero;
       cur[0] = ws.horizontal[x & 1];
@@ -244,11 +323,41 @@ void SemiGlobalMatcher::aggregate(int w, int h) noexcept {
         prev[3] = y + 1 < h && x > 0 ? at(prev_row[2], x - 1) : ws.zero;
         cur[3] = at(cur_row[2], x);
       }
-      update_paths<B, kN, false>(prev, cur, cost + x * pixel, sum + x * pixel, d, p1, p2);
+      const std::int16_t* s = sum + x * pixel;
+      const std::uint8_t* ps = pair_sum + x * pixel;
+      if (kFused) {
+        // The sums wait in a one-pixel buffer that stays in L1 rather than
+        // in registers: the paths already use nearly all of them.
+        up_paths<B, kN>(prev, cur, cost + x * pixel, s, ps, total, d, p1, jump);
+        winner.begin(x);
+        for (int k = 0; k < d; k += 8) winner.add(k, W::load(total + k));
+        winner.finish(total, out + x, scratch.left_best + x);
+      } else {
+        up_paths<B, kN>(prev, cur, cost + x * pixel, s, ps, row_sums + x * pixel, d, p1, jump);
+      }
     }
     std::swap(prev_row, cur_row);
-    select_disparity_row(sum, w, d, params_.uniqueness_percent, params_.lr_max_diff, scratch, ws.disparity.row(y));
+    if (kFused) {
+      winner.check_right(scratch.left_best, params_.lr_max_diff, out);
+    } else {
+      select_disparity_row(row_sums, w, d, params_.uniqueness_percent, params_.lr_max_diff, scratch, out);
+    }
   }
+}
+
+void SemiGlobalMatcher::census_costs(int y, int w) noexcept {
+  Workspace& ws = *ws_;
+  const std::uint8_t* left_planes[kCensusPlanes];
+  const std::uint8_t* right_planes[kCensusPlanes];
+  for (int g = 0; g < kCensusPlanes; ++g) {
+    left_planes[g] = ws.census_left[g].row(y);
+    const std::uint8_t* r = ws.census_right[g].row(y);
+    std::uint8_t* rev = ws.right_reversed.get() + static_cast<std::ptrdiff_t>(g) * ws.reversed_stride;
+    for (int x = 0; x < w; ++x) rev[w - 1 - x] = r[x];
+    right_planes[g] = rev;
+  }
+  census_cost_row(left_planes, right_planes, w, disparities_,
+                  ws.cost.get() + static_cast<std::ptrdiff_t>(y) * w * disparities_);
 }
 
 void SemiGlobalMatcher::match(const GreyView& left_in, const GreyView& right_in, const DisparityImage& out) noexcept {
@@ -264,26 +373,12 @@ void SemiGlobalMatcher::match(const GreyView& left_in, const GreyView& right_in,
   census_transform_9x7(left, ws.census_left);
   census_transform_9x7(right, ws.census_right);
 
-  const std::uint8_t* left_planes[kCensusPlanes];
-  const std::uint8_t* right_planes[kCensusPlanes];
-  for (int g = 0; g < kCensusPlanes; ++g) {
-    right_planes[g] = ws.right_reversed.get() + static_cast<std::ptrdiff_t>(g) * ws.reversed_stride;
-  }
-  const std::ptrdiff_t row_cells = static_cast<std::ptrdiff_t>(w) * d;
-  for (int y = 0; y < h; ++y) {
-    for (int g = 0; g < kCensusPlanes; ++g) {
-      left_planes[g] = ws.census_left[g].row(y);
-      const std::uint8_t* r = ws.census_right[g].row(y);
-      std::uint8_t* rev = ws.right_reversed.get() + static_cast<std::ptrdiff_t>(g) * ws.reversed_stride;
-      for (int x = 0; x < w; ++x) rev[w - 1 - x] = r[x];
-    }
-    census_cost_row(left_planes, right_planes, w, d, ws.cost.get() + y * row_cells);
-  }
-
+  // Sums are at most paths * (P2 + the largest cost): see kMaxP2.
+  const bool fused = packed_winner_fits(params_.paths * (params_.p2 + kCensusBits), d);
   if (params_.paths == 8) {
-    aggregate<simd::NativeU8, 8>(w, h);
+    fused ? aggregate<simd::NativeU8, 8, true>(w, h) : aggregate<simd::NativeU8, 8, false>(w, h);
   } else {
-    aggregate<simd::NativeU8, 4>(w, h);
+    fused ? aggregate<simd::NativeU8, 4, true>(w, h) : aggregate<simd::NativeU8, 4, false>(w, h);
   }
 
   // The census window's margin repeats border pixels: no estimate there.

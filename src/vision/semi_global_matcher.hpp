@@ -13,9 +13,11 @@
 //      16-bit volume. Path costs fit a byte (P2 <= 96), so sixteen
 //      disparities go in a vector (simd_u8.hpp: SSE2, NEON or plain, the
 //      same integers);
-//   4. per row, once both passes have been through it: winner-take-all,
-//      uniqueness, left-right check, parabola fraction
-//      (disparity_selection.hpp); then speckles removed (speckle_filter.hpp).
+//   4. per pixel, as the upward pass finishes its sums: winner-take-all,
+//      uniqueness, parabola fraction, and per row the left-right check
+//      (packed_winner.hpp; disparity_selection.hpp where the sums are too
+//      wide to pack, with the same results); then speckles removed
+//      (speckle_filter.hpp).
 //
 // Integer arithmetic from the pixels to the disparities, so every machine
 // and every backend gives the same bits. All memory (the cost and sum
@@ -72,8 +74,9 @@ class SemiGlobalMatcher {
 
  private:
   struct Workspace;
-  template <class B, int kPaths>
+  template <class B, int kPaths, bool kFused>
   void aggregate(int w, int h) noexcept;
+  void census_costs(int y, int w) noexcept;
   void match(const GreyView& left, const GreyView& right, const DisparityImage& out) noexcept;
 
   DisparityParams params_;

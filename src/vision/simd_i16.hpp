@@ -77,6 +77,15 @@ struct PlainI16 {
     for (int i = 1; i < 8; ++i) m = a.x[i] < m ? a.x[i] : m;
     return m;
   }
+  static V bit_and(V a, V b) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = static_cast<std::int16_t>(a.x[i] & b.x[i]);
+    return a;
+  }
+  // Each lane's bits moved n (0..15) places up, the top ones dropped.
+  static V shl(V a, int n) noexcept {
+    for (int i = 0; i < 8; ++i) a.x[i] = static_cast<std::int16_t>(static_cast<std::uint16_t>(static_cast<std::uint16_t>(a.x[i]) << n));
+    return a;
+  }
 };
 
 #if defined(__SSE2__)
@@ -103,6 +112,8 @@ struct NativeI16 {
     a = _mm_min_epi16(a, _mm_shufflelo_epi16(a, _MM_SHUFFLE(2, 3, 0, 1)));
     return static_cast<std::int16_t>(_mm_cvtsi128_si32(a));
   }
+  static V bit_and(V a, V b) noexcept { return _mm_and_si128(a, b); }
+  static V shl(V a, int n) noexcept { return _mm_sll_epi16(a, _mm_cvtsi32_si128(n)); }
 };
 constexpr bool kNativeIsVector = true;
 #elif defined(__ARM_NEON)
@@ -123,6 +134,8 @@ struct NativeI16 {
   static V sub(V a, V b) noexcept { return vsubq_s16(a, b); }
   static V load_u8(const std::uint8_t* p) noexcept { return vreinterpretq_s16_u16(vmovl_u8(vld1_u8(p))); }
   static int hmin(V a) noexcept { return vminvq_s16(a); }
+  static V bit_and(V a, V b) noexcept { return vandq_s16(a, b); }
+  static V shl(V a, int n) noexcept { return vshlq_s16(a, vdupq_n_s16(static_cast<std::int16_t>(n))); }
 };
 constexpr bool kNativeIsVector = true;
 #else

@@ -64,6 +64,21 @@ struct PlainU8 {
     for (int i = 1; i < 16; ++i) m = a.x[i] < m ? a.x[i] : m;
     return m;
   }
+  // The sixteen bytes one place earlier in memory: before's last, then
+  // a's first fifteen.
+  static V shift_in_before(V a, V before) noexcept {
+    V r;
+    r.x[0] = before.x[15];
+    for (int i = 1; i < 16; ++i) r.x[i] = a.x[i - 1];
+    return r;
+  }
+  // One place later: a's last fifteen, then after's first.
+  static V shift_in_after(V a, V after) noexcept {
+    V r;
+    for (int i = 0; i < 15; ++i) r.x[i] = a.x[i + 1];
+    r.x[15] = after.x[0];
+    return r;
+  }
   // Lanes 0..7 and 8..15 as 16-bit lanes, zero-extended.
   using Wide = PlainI16;
   static Wide::V widen_lo(V a) noexcept {
@@ -85,6 +100,11 @@ struct PlainU8 {
     }
     return a;
   }
+  // The bits set in a0 ^ b0, a1 ^ b1, a2 ^ b2 and a3 ^ b3 together, per
+  // byte; the last pair's top bits must be clear (the census's 31 bits).
+  static V xor_popcount4(V a0, V b0, V a1, V b1, V a2, V b2, V a3, V b3) noexcept {
+    return add(add(xor_popcount(a0, b0), xor_popcount(a1, b1)), add(xor_popcount(a2, b2), xor_popcount(a3, b3)));
+  }
 };
 
 #if defined(__SSE2__)
@@ -105,6 +125,12 @@ struct NativeU8 {
     a = _mm_min_epu8(a, _mm_srli_si128(a, 1));
     return _mm_cvtsi128_si32(a) & 0xff;
   }
+  static V shift_in_before(V a, V before) noexcept {
+    return _mm_or_si128(_mm_slli_si128(a, 1), _mm_srli_si128(before, 15));
+  }
+  static V shift_in_after(V a, V after) noexcept {
+    return _mm_or_si128(_mm_srli_si128(a, 1), _mm_slli_si128(after, 15));
+  }
   using Wide = NativeI16;
   static Wide::V widen_lo(V a) noexcept { return _mm_unpacklo_epi8(a, _mm_setzero_si128()); }
   static Wide::V widen_hi(V a) noexcept { return _mm_unpackhi_epi8(a, _mm_setzero_si128()); }
@@ -122,6 +148,24 @@ struct NativeU8 {
     v = _mm_add_epi8(_mm_and_si128(v, m2), _mm_and_si128(_mm_srli_epi16(v, 2), m2));
     return _mm_and_si128(_mm_add_epi8(v, _mm_srli_epi16(v, 4)), m4);
   }
+  // Four counts share the last step: per nibble a count is at most 4, and
+  // a3 ^ b3's top nibble (three bits) at most 3, so two pairs' nibbles add
+  // up without a carry (at most 8), and the four high nibbles too (at most
+  // 15) once the low ones (up to 16) are masked off.
+  static V xor_popcount4(V a0, V b0, V a1, V b1, V a2, V b2, V a3, V b3) noexcept {
+    const __m128i m4 = _mm_set1_epi8(0x0f), m4_high = _mm_set1_epi8(static_cast<char>(0xf0));
+    const __m128i n01 = _mm_add_epi8(nibble_counts(_mm_xor_si128(a0, b0)), nibble_counts(_mm_xor_si128(a1, b1)));
+    const __m128i n23 = _mm_add_epi8(nibble_counts(_mm_xor_si128(a2, b2)), nibble_counts(_mm_xor_si128(a3, b3)));
+    const __m128i high = _mm_add_epi8(_mm_and_si128(n01, m4_high), _mm_and_si128(n23, m4_high));
+    const __m128i low = _mm_add_epi8(_mm_and_si128(n01, m4), _mm_and_si128(n23, m4));
+    return _mm_add_epi8(_mm_and_si128(_mm_srli_epi16(high, 4), m4), low);
+  }
+  // Each nibble's bit count (0..4).
+  static V nibble_counts(V v) noexcept {
+    const __m128i m1 = _mm_set1_epi8(0x55), m2 = _mm_set1_epi8(0x33);
+    v = _mm_sub_epi8(v, _mm_and_si128(_mm_srli_epi16(v, 1), m1));
+    return _mm_add_epi8(_mm_and_si128(v, m2), _mm_and_si128(_mm_srli_epi16(v, 2), m2));
+  }
 };
 #elif defined(__ARM_NEON)
 struct NativeU8 {
@@ -135,11 +179,17 @@ struct NativeU8 {
   static V adds(V a, V b) noexcept { return vqaddq_u8(a, b); }
   static V min(V a, V b) noexcept { return vminq_u8(a, b); }
   static int hmin(V a) noexcept { return vminvq_u8(a); }
+  static V shift_in_before(V a, V before) noexcept { return vextq_u8(before, a, 15); }
+  static V shift_in_after(V a, V after) noexcept { return vextq_u8(a, after, 1); }
   using Wide = NativeI16;
   static Wide::V widen_lo(V a) noexcept { return vreinterpretq_s16_u16(vmovl_u8(vget_low_u8(a))); }
   static Wide::V widen_hi(V a) noexcept { return vreinterpretq_s16_u16(vmovl_u8(vget_high_u8(a))); }
   static V bit_if_less(V a, V b, std::uint8_t bit) noexcept { return vandq_u8(vcltq_u8(a, b), vdupq_n_u8(bit)); }
   static V xor_popcount(V a, V b) noexcept { return vcntq_u8(veorq_u8(a, b)); }
+  static V xor_popcount4(V a0, V b0, V a1, V b1, V a2, V b2, V a3, V b3) noexcept {
+    return vaddq_u8(vaddq_u8(xor_popcount(a0, b0), xor_popcount(a1, b1)),
+                    vaddq_u8(xor_popcount(a2, b2), xor_popcount(a3, b3)));
+  }
 };
 #else
 using NativeU8 = PlainU8;

@@ -16,7 +16,6 @@ int SpeckleFilter::filter(std::int16_t* disp, int width, int height, int stride,
   if (width <= 0 || height <= 0 || static_cast<long long>(width) * height > max_pixels_ || max_size <= 0) return 0;
   std::int32_t* labels = labels_.get();
   std::memset(labels, 0, sizeof(std::int32_t) * static_cast<std::size_t>(width) * static_cast<std::size_t>(height));
-  auto value = [&](int i) -> std::int16_t& { return disp[static_cast<std::ptrdiff_t>(i / width) * stride + i % width]; };
   int next_label = 0, removed = 0;
   for (int y = 0; y < height; ++y) {
     std::int16_t* row = disp + static_cast<std::ptrdiff_t>(y) * stride;
@@ -38,19 +37,22 @@ int SpeckleFilter::filter(std::int16_t* disp, int width, int height, int stride,
       while (top > 0) {
         const int p = stack_[--top];
         ++count;
-        const int px = p % width, py = p / width;
-        const int v = value(p);
-        auto visit = [&](int q) {
+        // One division per region pixel; the neighbours' values are found
+        // from its row (a division per neighbour cost more than the fill).
+        const int py = p / width, px = p - py * width;
+        const std::int16_t* at = disp + static_cast<std::ptrdiff_t>(py) * stride + px;
+        const int v = *at;
+        auto visit = [&](int q, const std::int16_t* value) {
           if (labels[q] != 0) return;
-          const int vq = value(q);
+          const int vq = *value;
           if (vq < 0 || std::abs(vq - v) > max_diff) return;
           labels[q] = label;
           stack_[top++] = q;
         };
-        if (px > 0) visit(p - 1);
-        if (px + 1 < width) visit(p + 1);
-        if (py > 0) visit(p - width);
-        if (py + 1 < height) visit(p + width);
+        if (px > 0) visit(p - 1, at - 1);
+        if (px + 1 < width) visit(p + 1, at + 1);
+        if (py > 0) visit(p - width, at - stride);
+        if (py + 1 < height) visit(p + width, at + stride);
       }
       small_[label] = count <= max_size ? 1 : 0;
       if (small_[label] != 0) {

@@ -19,6 +19,8 @@
 #include "vision/census_cost.hpp"
 #include "vision/census_transform.hpp"
 #include "vision/disparity_selection.hpp"
+#include "vision/packed_winner.hpp"
+#include "vision/simd_u8.hpp"
 
 namespace rtfuse::vision {
 namespace semi_global_matcher_test {
@@ -331,6 +333,74 @@ TEST(SemiGlobalMatcher, VectorAndPlainBackendsAgree) {
     select_disparity_row_portable(sums.data(), w, d, uniqueness, 1, scratch, out_plain.data());
     ASSERT_EQ(out_native, out_plain);
   }
+  // Four planes' counts at once, on the worst case for its nibble sums
+  // (every bit different) and on random bytes.
+  std::uint8_t a[8][16];
+  for (int round = 0; round < 64; ++round) {
+    for (int k = 0; k < 8; ++k) {
+      for (int i = 0; i < 16; ++i) {
+        const auto r = static_cast<std::uint8_t>(rng());
+        a[k][i] = round % 2 == 0 ? static_cast<std::uint8_t>((r & 1) != 0 ? 0xff : 0) : r;
+        if (k >= 6) a[k][i] &= 0x7f;  // the last plane's 7 bits
+      }
+    }
+    using N = simd::NativeU8;
+    using P = simd::PlainU8;
+    std::uint8_t native_count[16];
+    N::store(native_count, N::xor_popcount4(N::load(a[0]), N::load(a[1]), N::load(a[2]), N::load(a[3]), N::load(a[4]),
+                                            N::load(a[5]), N::load(a[6]), N::load(a[7])));
+    const P::V plain_count = P::xor_popcount4(P::load(a[0]), P::load(a[1]), P::load(a[2]), P::load(a[3]),
+                                              P::load(a[4]), P::load(a[5]), P::load(a[6]), P::load(a[7]));
+    ASSERT_EQ(std::memcmp(native_count, plain_count.x, 16), 0) << round;
+  }
+}
+
+// The selection fused into the matcher's last pass (packed_winner.hpp)
+// against the two-pass selection, with both backends: the same
+// disparities, on random sums with many ties, with and without the cut of
+// the left columns, uniqueness and the left-right check.
+TEST(SemiGlobalMatcher, PackedSelectionMatchesTwoPassSelection) {
+  std::mt19937 rng(11);
+  for (const int d : {16, 32, 64}) {
+    const int w = 150;
+    std::vector<std::int16_t> sums(static_cast<std::size_t>(w) * d);
+    std::vector<std::int16_t> lb(w), rb(w + d), rc(w + d), expected(w), native(w), plain(w);
+    const DisparityRowScratch scratch{lb.data(), rb.data(), rc.data()};
+    for (int round = 0; round < 20; ++round) {
+      const int range = round % 2 == 0 ? 8 : 728;  // ties, or the default's largest sums
+      for (auto& s : sums) s = static_cast<std::int16_t>(rng() % range);
+      ASSERT_TRUE(packed_winner_fits(728, d));
+      for (const int uniqueness : {0, 10, 50}) {
+        for (const int lr : {-1, 0, 1}) {
+          select_disparity_row_portable(sums.data(), w, d, uniqueness, lr, scratch, expected.data());
+          select_disparity_row_packed<simd::NativeI16>(sums.data(), w, d, uniqueness, lr, scratch, native.data());
+          select_disparity_row_packed<simd::PlainI16>(sums.data(), w, d, uniqueness, lr, scratch, plain.data());
+          ASSERT_EQ(native, expected) << d << " " << round << " " << uniqueness << " " << lr;
+          ASSERT_EQ(plain, expected) << d << " " << round << " " << uniqueness << " " << lr;
+        }
+      }
+    }
+  }
+  EXPECT_FALSE(packed_winner_fits(728, 128));  // the matcher selects in two passes then
+}
+
+// Sums too wide to pack with their disparity (a larger P2 and range) take
+// the two-pass selection; both paths through the matcher find the scene.
+TEST(SemiGlobalMatcher, WideSumsFallBackToTwoPassSelection) {
+  const Pair p = occlusion_scene();
+  DisparityParams fused = params32();
+  ASSERT_TRUE(packed_winner_fits(fused.paths * (fused.p2 + kCensusBits), fused.disparities));
+  DisparityParams two_pass = fused;
+  two_pass.p2 = 96;
+  two_pass.disparities = 128;
+  ASSERT_FALSE(packed_winner_fits(two_pass.paths * (two_pass.p2 + kCensusBits), two_pass.disparities));
+  const Match a = run(p, fused), b = run(p, two_pass);
+  ASSERT_EQ(a.status, DisparityStatus::kOk);
+  ASSERT_EQ(b.status, DisparityStatus::kOk);
+  int n = 0;
+  const auto truth = [](int x, int y) { return y >= 24 && y < 72 && x >= 60 && x < 100 ? 20.0 : 4.0; };
+  EXPECT_GE(share_within(b, 64, 1.0, truth, &n), 0.95);
+  EXPECT_GE(share_within(a, 64, 1.0, truth, &n), 0.95);
 }
 
 TEST(SemiGlobalMatcher, SubpixelOffsetIsSymmetricAndBounded) {
