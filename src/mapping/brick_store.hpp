@@ -34,8 +34,13 @@ struct Brick {
   std::uint32_t sub[8];        // a value, kUnknownBits or dense_slot(block)
   std::uint32_t scan;          // the scan touched[] belongs to
   std::uint32_t reserved;
-  std::uint64_t touched[8];    // voxels updated in that scan, a bit each
+  std::uint64_t touched[8];    // voxels updated in that scan: touched_word, touched_bit_of
 };
+
+// A voxel's bit in Brick::touched: one word a z-slice, x then y in it, so
+// the bit comes from a packed key (pack()) in a few shifts and masks.
+inline int touched_word(const VoxelKey& k) noexcept { return k.k[2] & 7; }
+inline int touched_bit_of(const VoxelKey& k) noexcept { return (k.k[0] & 7) | (k.k[1] & 7) << 3; }
 
 inline std::uint64_t brick_key_of(const VoxelKey& k) noexcept {
   return static_cast<std::uint64_t>(k.k[0] >> kBrickShift) |

@@ -56,10 +56,11 @@ class OccupancyMap::ScanWriter {
       }
     }
     Brick& b = map_.store_.brick(cached_);
+    std::uint64_t& touched = b.touched[touched_word(key)];
+    const std::uint64_t touched_bit = std::uint64_t{1} << touched_bit_of(key);
+    if (touched & touched_bit) return;
     const int s = sub_of(key);
     const int v = voxel_of(key);
-    const std::uint64_t bit = std::uint64_t{1} << v;
-    if (b.touched[s] & bit) return;
     std::uint32_t slot = b.sub[s];
     if (!is_dense(slot)) {
       const std::uint32_t block = map_.store_.new_block(slot);
@@ -69,7 +70,7 @@ class OccupancyMap::ScanWriter {
       }
       slot = b.sub[s] = dense_slot(block);
     }
-    b.touched[s] |= bit;
+    touched |= touched_bit;
     std::uint32_t& cell = map_.store_.block_values(block_of(slot))[v];
     const bool was_known = cell != kUnknownBits;
     float value = was_known ? float_of(cell) : 0.0f;
@@ -94,6 +95,24 @@ class OccupancyMap::ScanWriter {
     ++counter;
   }
 
+  // A brick's touched mask and the packed keys (pack()) of its voxels with
+  // the low three bits of every axis cleared; base never matches a key
+  // when there is no brick.
+  struct TouchedBrick {
+    std::uint64_t base;
+    const std::uint64_t* touched;
+  };
+  static constexpr std::uint64_t kBrickBits = 0x0000FFF8FFF8FFF8ull;
+
+  // A free voxel of a ray whose brick the recent table missed or whose bit
+  // is not set: the update, and the brick for the table. Out of line so
+  // the ray loop keeps its registers.
+  [[gnu::noinline]] TouchedBrick free_slow(std::uint64_t packed, std::uint32_t& counter) noexcept {
+    update(unpack(packed), map_.log_odds_.miss, counter);
+    if (cached_key_ == kNoBrick) return TouchedBrick{~std::uint64_t{0}, nullptr};
+    return TouchedBrick{packed & kBrickBits, map_.store_.brick(cached_).touched};
+  }
+
   std::uint32_t dropped() const noexcept { return dropped_; }
 
  private:
@@ -104,6 +123,17 @@ class OccupancyMap::ScanWriter {
 };
 
 namespace {
+
+constexpr int kRecentBricks = 256;
+
+// The recent-brick slot of a packed key: the brick coordinates' low bits
+// (x and y three, z two) gathered by one multiply into the top byte; the
+// other partial products stay below bit 49.
+inline std::size_t recent_slot(std::uint64_t packed) noexcept {
+  constexpr std::uint64_t kLowBrickBits = std::uint64_t{7} << 3 | std::uint64_t{7} << 19 | std::uint64_t{3} << 35;
+  constexpr std::uint64_t kGather = std::uint64_t{1} << 53 | std::uint64_t{1} << 40 | std::uint64_t{1} << 27;
+  return static_cast<std::size_t>(((packed & kLowBrickBits) * kGather) >> 56);
+}
 
 struct Offset {
   float x, y, z;
@@ -156,8 +186,29 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     }
   }
 
-  const auto free = [&](const VoxelKey& key) __attribute__((always_inline)) {
-    writer.update(key, log_odds_.miss, result.frees);
+  // Most voxels of a ray were freed by an earlier ray of the scan (6 M
+  // visits for 0.3 M voxels on scan.dat at 0.1 m within 10 m), and a ray
+  // changes brick every seven voxels or so, at a coin toss, mostly to one
+  // an earlier ray used. So a visit is checked against a small
+  // direct-mapped table of the scan's bricks (any 8 x 8 x 4 of them fit),
+  // with no branch on a brick change; only a miss or a new voxel takes the
+  // call and the brick hash table, whose slots are spread over megabytes.
+  std::uint64_t recent_base[kRecentBricks];
+  const std::uint64_t* recent_touched[kRecentBricks];
+  for (int i = 0; i < kRecentBricks; ++i) {
+    recent_base[i] = ~std::uint64_t{0};
+    recent_touched[i] = nullptr;
+  }
+  const auto free = [&](std::uint64_t packed) __attribute__((always_inline)) {
+    const std::uint64_t base = packed & ScanWriter::kBrickBits;
+    const std::size_t slot = recent_slot(packed);
+    if (recent_base[slot] == base &&
+        (recent_touched[slot][packed >> 32 & 7] >> ((packed & 7) | (packed >> 13 & 0x38)) & 1) != 0) {
+      return;
+    }
+    const ScanWriter::TouchedBrick brick = writer.free_slow(packed, result.frees);
+    recent_base[slot] = brick.base;
+    recent_touched[slot] = brick.touched;
   };
   const float range = static_cast<float>(max_range);
   for (std::size_t i = 0; i < count; ++i) {
@@ -165,7 +216,7 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     if (!is_finite(p)) continue;
     const Offset d = offset_of(p, origin);
     if (!limited || d.length <= max_range) {
-      traverse_ray(grid_, origin, p, free);
+      traverse_ray_packed(grid_, origin, p, free);
       continue;
     }
     ++result.beyond_range;
@@ -173,7 +224,7 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     const float length = static_cast<float>(d.length);
     const MapPoint end{origin.x + (d.x / length) * range, origin.y + (d.y / length) * range,
                        origin.z + (d.z / length) * range};
-    if (!traverse_ray(grid_, origin, end, free)) ++result.outside;
+    if (!traverse_ray_packed(grid_, origin, end, free)) ++result.outside;
   }
 
   result.dropped = writer.dropped();
@@ -188,7 +239,11 @@ void OccupancyMap::compact_touched() noexcept {
   for (std::uint32_t t = 0; t < touched_count_; ++t) {
     Brick& b = store_.brick(touched_[t]);
     for (int s = 0; s < 8; ++s) {
-      if (b.touched[s] == 0 || !is_dense(b.sub[s])) continue;
+      if (!is_dense(b.sub[s])) continue;
+      // The sub-brick's 4 x 4 x 4 corner of the brick's z-slices.
+      const std::uint64_t quadrant = std::uint64_t{0x0F0F0F0F} << ((s & 1) * 4 + (s >> 1 & 1) * 32);
+      const std::uint64_t* slices = &b.touched[(s >> 2) * 4];
+      if (((slices[0] | slices[1] | slices[2] | slices[3]) & quadrant) == 0) continue;
       const std::uint32_t block = block_of(b.sub[s]);
       const std::uint32_t* v = store_.block_values(block);
       const std::uint32_t first = v[0];

@@ -58,16 +58,122 @@ void traverse_exact(double* t_max, const double* t_delta, const int* step, Voxel
 
 }  // namespace detail
 
-// Calls visit(const VoxelKey&) for each voxel from origin towards end, end's
-// voxel excluded. False (nothing visited) when either point is outside the
-// map. The number of voxels is bounded by the segment's length over the
-// resolution (at most three steps per voxel length).
+inline VoxelKey unpack(std::uint64_t packed) noexcept {
+  VoxelKey k;
+  k.k[0] = static_cast<std::uint16_t>(packed);
+  k.k[1] = static_cast<std::uint16_t>(packed >> 16);
+  k.k[2] = static_cast<std::uint16_t>(packed >> 32);
+  return k;
+}
+
+namespace detail {
+
+// The step of the axis chosen (choose()): each axis moves its distance to
+// the next sum (t = n), the next to the one after (n = ahead, the bits of
+// the sum two steps ahead), sets key_step to its step of the packed key,
+// and returns its delta as the addend for the sum ahead (else +0.0). Axis
+// 0 steps when lt & lt01, axis 1 when lt & !lt01, axis 2 when !lt.
+// On x86-64 these selects are inline asm, one flag test feeding an axis's
+// four conditional moves: GCC turns plain ?: of which axis steps back into
+// branches, a coin toss the predictor loses about every other voxel.
+// Elsewhere plain C.
+struct AxisStep {
+  std::uint64_t& t;
+  std::uint64_t& n;
+  std::uint64_t ahead;
+  std::uint64_t delta;
+  std::uint64_t key;
+};
+
+// The moves of a stepping axis, under the flags the caller's test left.
+#define RTFUSE_RAY_MOVES(cc) \
+  "\n\tcmov" cc " %1, %0\n\tcmov" cc " %6, %1\n\tcmov" cc " %7, %2\n\tcmov" cc " %8, %3"
+#define RTFUSE_RAY_OPERANDS                                      \
+  : "+r"(a.t), "+r"(a.n), "+r"(add), "+r"(key_step)              \
+  : "q"(lt), "q"(lt01), "r"(a.ahead), "rm"(a.delta), "rm"(a.key) \
+  : "cc"
+
+inline std::uint64_t step_axis(bool steps, AxisStep a, std::uint64_t& key_step) noexcept {
+  if (!steps) return 0;
+  a.t = a.n;
+  a.n = a.ahead;
+  key_step = a.key;
+  return a.delta;
+}
+
+inline std::uint64_t advance0(AxisStep a, bool lt, bool lt01, std::uint64_t& key_step) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+  std::uint64_t add = 0;
+  __asm__("testb %5, %4" RTFUSE_RAY_MOVES("ne") RTFUSE_RAY_OPERANDS);
+  return add;
+#else
+  return step_axis(lt && lt01, a, key_step);
+#endif
+}
+inline std::uint64_t advance1(AxisStep a, bool lt, bool lt01, std::uint64_t& key_step) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+  std::uint64_t add = 0;
+  __asm__("cmpb %5, %4" RTFUSE_RAY_MOVES("a") RTFUSE_RAY_OPERANDS);  // lt > lt01, as bytes 0 and 1
+  return add;
+#else
+  return step_axis(lt && !lt01, a, key_step);
+#endif
+}
+inline std::uint64_t advance2(AxisStep a, bool lt, bool lt01, std::uint64_t& key_step) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+  std::uint64_t add = 0;
+  __asm__("testb %4, %4" RTFUSE_RAY_MOVES("e") RTFUSE_RAY_OPERANDS);
+  return add;
+#else
+  (void)lt01;
+  return step_axis(!lt, a, key_step);
+#endif
+}
+#undef RTFUSE_RAY_OPERANDS
+#undef RTFUSE_RAY_MOVES
+
+// The axis OctoMap steps next, t0 < t1 ? (t0 < t2 ? 0 : 2) : (t1 < t2 ? 1
+// : 2), as the smaller of t0, t1 (ties to t1) against t2 (ties to t2):
+// lt01 = t0 < t1, lt = min01 < t2; returns the smallest distance.
+inline std::uint64_t choose(std::uint64_t t0, std::uint64_t t1, std::uint64_t t2, bool& lt01, bool& lt) noexcept {
+#if defined(__x86_64__) && defined(__GNUC__)
+  std::uint64_t m01 = t1, m = t2;
+  __asm__("cmpq %5, %4\n\tcmovb %4, %0\n\tsetb %2\n\tcmpq %6, %0\n\tcmovb %0, %1\n\tsetb %3"
+          : "+&r"(m01), "+&r"(m), "=&q"(lt01), "=&q"(lt)
+          : "r"(t0), "r"(t1), "r"(t2)
+          : "cc");
+  return m;
+#else
+  lt01 = t0 < t1;
+  const std::uint64_t m01 = lt01 ? t0 : t1;
+  lt = m01 < t2;
+  return lt ? m01 : t2;
+#endif
+}
+
+// Keys this close to the map's edge could step out of their 16 bits, which
+// the packed key (one 64-bit word, stepped by one add) would carry into the
+// next axis; OctoMap's loop as written takes those rays.
+inline bool near_edge(const VoxelKey& k) noexcept {
+  for (int i = 0; i < 3; ++i) {
+    if (k.k[i] < 2 || k.k[i] > 65533) return true;
+  }
+  return false;
+}
+
+}  // namespace detail
+
+// Calls visit(std::uint64_t packed_key) (pack()) for each voxel from origin
+// towards end, end's voxel excluded. False (nothing visited) when either
+// point is outside the map. The number of voxels is bounded by the
+// segment's length over the resolution (at most three steps per voxel
+// length).
 template <class Visit>
-bool traverse_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
+bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
   VoxelKey key_origin, key_end;
   if (!grid.key_of(origin, key_origin) || !grid.key_of(end, key_end)) return false;
   if (key_origin == key_end) return true;
-  visit(key_origin);
+  visit(pack(key_origin));
 
   const float dir[3] = {end.x - origin.x, end.y - origin.y, end.z - origin.z};
   const float o[3] = {origin.x, origin.y, origin.z};
@@ -79,11 +185,10 @@ bool traverse_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint&
   int step[3];
   double t_max[3];
   double t_delta[3];
-  VoxelKey current = key_origin;
   for (int i = 0; i < 3; ++i) {
     step[i] = d[i] > 0.0f ? 1 : (d[i] < 0.0f ? -1 : 0);
     if (step[i] != 0) {
-      double border = grid.centre(current.k[i]);
+      double border = grid.centre(key_origin.k[i]);
       border += static_cast<float>(step[i] * resolution * 0.5);
       t_max[i] = (border - static_cast<double>(o[i])) / static_cast<double>(d[i]);
       t_delta[i] = resolution / static_cast<double>(std::fabs(d[i]));
@@ -94,10 +199,13 @@ bool traverse_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint&
   }
 
   const double limit = static_cast<double>(length);
-  if (t_max[0] < 0.0 || t_max[1] < 0.0 || t_max[2] < 0.0) {
-    // An origin a rounding away from its voxel's far border: OctoMap's loop
-    // as written, for negative distances order differently as integers.
-    detail::traverse_exact(t_max, t_delta, step, current, key_end, limit, visit);
+  if (t_max[0] < 0.0 || t_max[1] < 0.0 || t_max[2] < 0.0 || detail::near_edge(key_origin) ||
+      detail::near_edge(key_end)) {
+    // An origin a rounding away from its voxel's far border (negative
+    // distances order differently as integers), or a ray at the map's
+    // edge: OctoMap's loop as written.
+    auto visit_key = [&](const VoxelKey& k) { visit(pack(k)); };
+    detail::traverse_exact(t_max, t_delta, step, key_origin, key_end, limit, visit_key);
     return true;
   }
   // OctoMap's loop without its branches: which axis steps next is a coin
@@ -105,38 +213,42 @@ bool traverse_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint&
   // most of the traversal's time. Non-negative doubles order as their bit
   // patterns do, so the comparisons are integer ones feeding conditional
   // moves, and each axis's next distance is summed ahead (OctoMap's same
-  // sum, tMax + tDelta), off the path from one step to the next.
-  const double d0 = t_delta[0], d1 = t_delta[1], d2 = t_delta[2];
+  // sum, tMax + tDelta), off the path from one step to the next. An axis
+  // that does not step adds +0.0, which leaves a non-negative sum as it is.
+  const std::uint64_t dd0 = detail::bits_of(t_delta[0]), dd1 = detail::bits_of(t_delta[1]),
+                      dd2 = detail::bits_of(t_delta[2]);
   double a0 = t_max[0] + 0.0, a1 = t_max[1] + 0.0, a2 = t_max[2] + 0.0;  // + 0.0: -0.0 becomes +0.0
-  double b0 = a0 + d0, b1 = a1 + d1, b2 = a2 + d2;
+  double b0 = a0 + t_delta[0], b1 = a1 + t_delta[1], b2 = a2 + t_delta[2];
   std::uint64_t t0 = detail::bits_of(a0), t1 = detail::bits_of(a1), t2 = detail::bits_of(a2);
   std::uint64_t n0 = detail::bits_of(b0), n1 = detail::bits_of(b1), n2 = detail::bits_of(b2);
-  double c0 = b0 + d0, c1 = b1 + d1, c2 = b2 + d2;  // the sums two steps ahead
+  double c0 = b0 + t_delta[0], c1 = b1 + t_delta[1], c2 = b2 + t_delta[2];  // the sums two steps ahead
+  // A step is one add to the packed key (no field leaves its 16 bits: near_edge).
+  const std::uint64_t k0 = static_cast<std::uint64_t>(static_cast<std::int64_t>(step[0]));
+  const std::uint64_t k1 = static_cast<std::uint64_t>(static_cast<std::int64_t>(step[1]) * 65536);
+  const std::uint64_t k2 = static_cast<std::uint64_t>(static_cast<std::int64_t>(step[2]) * 65536 * 65536);
+  std::uint64_t current = pack(key_origin);
   const std::uint64_t end_packed = pack(key_end);
   const std::uint64_t limit_bits = detail::bits_of(limit);
+  bool lt01, lt;
+  detail::choose(t0, t1, t2, lt01, lt);
   for (;;) {
-    const bool lt01 = t0 < t1;
-    const bool s0 = lt01 & (t0 < t2);
-    const bool s1 = !lt01 & (t1 < t2);
-    const bool s2 = !(s0 | s1);
-    const std::uint64_t m0 = detail::bits_of(c0), m1 = detail::bits_of(c1), m2 = detail::bits_of(c2);
-    t0 = s0 ? n0 : t0;
-    t1 = s1 ? n1 : t1;
-    t2 = s2 ? n2 : t2;
-    n0 = s0 ? m0 : n0;
-    n1 = s1 ? m1 : n1;
-    n2 = s2 ? m2 : n2;
-    c0 = s0 ? c0 + d0 : c0;
-    c1 = s1 ? c1 + d1 : c1;
-    c2 = s2 ? c2 + d2 : c2;
-    current.k[0] = static_cast<std::uint16_t>(current.k[0] + (s0 ? step[0] : 0));
-    current.k[1] = static_cast<std::uint16_t>(current.k[1] + (s1 ? step[1] : 0));
-    current.k[2] = static_cast<std::uint16_t>(current.k[2] + (s2 ? step[2] : 0));
-    if (pack(current) == end_packed) break;
-    if (std::min(std::min(t0, t1), t2) > limit_bits) break;
+    std::uint64_t key_step = 0;
+    c0 += detail::double_of(detail::advance0({t0, n0, detail::bits_of(c0), dd0, k0}, lt, lt01, key_step));
+    c1 += detail::double_of(detail::advance1({t1, n1, detail::bits_of(c1), dd1, k1}, lt, lt01, key_step));
+    c2 += detail::double_of(detail::advance2({t2, n2, detail::bits_of(c2), dd2, k2}, lt, lt01, key_step));
+    current += key_step;
+    if (current == end_packed) break;
+    // min(tMax) > length, the minimum being the one the next step takes.
+    if (detail::choose(t0, t1, t2, lt01, lt) > limit_bits) break;
     visit(current);
   }
   return true;
+}
+
+// As traverse_ray_packed, calling visit(const VoxelKey&).
+template <class Visit>
+bool traverse_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
+  return traverse_ray_packed(grid, origin, end, [&](std::uint64_t packed) { visit(unpack(packed)); });
 }
 
 }  // namespace rtfuse::mapping
