@@ -8,7 +8,12 @@
 
 namespace rtfuse::apps {
 
-bool read_grey_png(const std::string& path, GreyPng* out, std::string* error) {
+namespace {
+
+// One PNG decoded by libpng's simplified API into `format` (its own
+// conversions), or false with *error naming the path and the cause.
+bool read_png(const std::string& path, png_uint_32 format, std::vector<std::uint8_t>* pixels, int* width,
+              int* height, std::string* error) {
   std::FILE* f = std::fopen(path.c_str(), "rb");
   if (f == nullptr) {
     *error = path + ": cannot open: " + std::strerror(errno);
@@ -22,7 +27,7 @@ bool read_grey_png(const std::string& path, GreyPng* out, std::string* error) {
     std::fclose(f);
     return false;
   }
-  image.format = PNG_FORMAT_GRAY;
+  image.format = format;
   if (image.width == 0 || image.height == 0 || image.width > 16384 || image.height > 16384) {
     *error = path + ": " + std::to_string(image.width) + " x " + std::to_string(image.height) +
              " pixels: not an image size this reads (1..16384 a side)";
@@ -30,50 +35,32 @@ bool read_grey_png(const std::string& path, GreyPng* out, std::string* error) {
     std::fclose(f);
     return false;
   }
-  GreyPng img;
-  img.width = static_cast<int>(image.width);
-  img.height = static_cast<int>(image.height);
-  img.pixels.resize(PNG_IMAGE_SIZE(image));
-  const bool ok = png_image_finish_read(&image, nullptr, img.pixels.data(), 0, nullptr) != 0;
+  pixels->resize(PNG_IMAGE_SIZE(image));
+  const bool ok = png_image_finish_read(&image, nullptr, pixels->data(), 0, nullptr) != 0;
   if (!ok) *error = path + ": cannot decode: " + image.message;
+  *width = static_cast<int>(image.width);
+  *height = static_cast<int>(image.height);
   png_image_free(&image);
   std::fclose(f);
-  if (!ok) return false;
+  return ok;
+}
+
+}  // namespace
+
+bool read_grey_png(const std::string& path, GreyPng* out, std::string* error) {
+  GreyPng img;
+  if (!read_png(path, PNG_FORMAT_GRAY, &img.pixels, &img.width, &img.height, error)) return false;
   *out = std::move(img);
   return true;
 }
 
 bool read_luma_png(const std::string& path, GreyPng* out, std::string* error) {
-  std::FILE* f = std::fopen(path.c_str(), "rb");
-  if (f == nullptr) {
-    *error = path + ": cannot open: " + std::strerror(errno);
-    return false;
-  }
-  png_image image;
-  std::memset(&image, 0, sizeof image);
-  image.version = PNG_IMAGE_VERSION;
-  if (!png_image_begin_read_from_stdio(&image, f)) {
-    *error = path + ": not a readable PNG: " + image.message;
-    std::fclose(f);
-    return false;
-  }
-  if (image.width == 0 || image.height == 0 || image.width > 16384 || image.height > 16384) {
-    *error = path + ": " + std::to_string(image.width) + " x " + std::to_string(image.height) +
-             " pixels: not an image size this reads (1..16384 a side)";
-    png_image_free(&image);
-    std::fclose(f);
-    return false;
-  }
-  image.format = PNG_FORMAT_RGB;
-  std::vector<std::uint8_t> rgb(PNG_IMAGE_SIZE(image));
-  const bool ok = png_image_finish_read(&image, nullptr, rgb.data(), 0, nullptr) != 0;
-  if (!ok) *error = path + ": cannot decode: " + image.message;
-  png_image_free(&image);
-  std::fclose(f);
-  if (!ok) return false;
+  std::vector<std::uint8_t> rgb;
+  int width = 0, height = 0;
+  if (!read_png(path, PNG_FORMAT_RGB, &rgb, &width, &height, error)) return false;
   GreyPng img;
-  img.width = static_cast<int>(image.width);
-  img.height = static_cast<int>(image.height);
+  img.width = width;
+  img.height = height;
   img.pixels.resize(static_cast<std::size_t>(img.width) * static_cast<std::size_t>(img.height));
   for (std::size_t i = 0; i < img.pixels.size(); ++i) {
     const unsigned r = rgb[3 * i], g = rgb[3 * i + 1], b = rgb[3 * i + 2];
