@@ -16,6 +16,7 @@
 
 #include "sim/camera_world.hpp"
 #include "sim/stereo_renderer.hpp"
+#include "support/pinhole_stereo.hpp"
 #include "vision/semi_global_matcher.hpp"
 
 namespace rtfuse::sim {
@@ -29,15 +30,7 @@ constexpr double kCy = 188.0;
 constexpr double kBaseline = 0.12;
 constexpr double kPi = 3.14159265358979323846;
 
-drivers::StereoCalibration pinhole_pair() {
-  drivers::StereoCalibration c;
-  c.width = kW;
-  c.height = kH;
-  c.left = {kF, kF, kCx, kCy, 0.0, 0.0, 0.0, 0.0, 0.0};
-  c.right = c.left;
-  c.translation = Eigen::Vector3d(-kBaseline, 0.0, 0.0);
-  return c;
-}
+drivers::StereoCalibration pinhole_pair() { return test::pinhole_stereo_pair(kW, kH, kF, kCx, kCy, kBaseline); }
 
 // The left eye's optical frame at (x, y, z), looking horizontally along yaw
 // and pitched down by `down` radians.
