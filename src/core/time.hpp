@@ -3,6 +3,7 @@
 // carry utime in microseconds, so conversions live here and nowhere else.
 #include <cmath>
 #include <cstdint>
+#include <cerrno>
 #include <ctime>
 
 namespace rtfuse {
@@ -37,6 +38,14 @@ inline timespec ns_to_timespec(TimeNs t) noexcept {
   ts.tv_sec = static_cast<time_t>(t / kNsPerSec);
   ts.tv_nsec = static_cast<long>(t % kNsPerSec);
   return ts;
+}
+
+// clock_nanosleep(TIMER_ABSTIME) until t, resuming after signals: the one
+// blocking call the real-time threads make.
+inline void sleep_until(TimeNs t) noexcept {
+  const timespec ts = ns_to_timespec(t);
+  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
+  }
 }
 
 }  // namespace rtfuse

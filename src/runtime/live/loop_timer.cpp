@@ -32,10 +32,4 @@ void LoopTimer::record(TimeNs woke, TimeNs done) noexcept {
   }
 }
 
-void sleep_until(TimeNs t) noexcept {
-  const timespec ts = ns_to_timespec(t);
-  while (clock_nanosleep(CLOCK_MONOTONIC, TIMER_ABSTIME, &ts, nullptr) == EINTR) {
-  }
-}
-
 }  // namespace rtfuse

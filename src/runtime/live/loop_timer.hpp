@@ -26,7 +26,4 @@ class LoopTimer {
   LoopStats stats_;
 };
 
-// clock_nanosleep(TIMER_ABSTIME) until t, resuming after signals.
-void sleep_until(TimeNs t) noexcept;
-
 }  // namespace rtfuse
