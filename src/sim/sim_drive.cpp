@@ -150,6 +150,7 @@ DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
     }
     ++loop.ticks;
     pipeline->step(t, loop, output);
+    if (Hardware* hw = pipeline->hardware()) hw->step_workers();
     const Snapshot& snap = pipeline->core().last_snapshot();
     const TruthState truth = robot->truth_at(t);
     if (options.after_tick) options.after_tick(t, snap, truth);
@@ -192,6 +193,7 @@ DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
       progress(prog);
     }
   }
+  if (Hardware* hw = pipeline->hardware()) hw->finish_workers();
   result.duration_s = duration;
   for (int k = 0; k < result.num_instances; ++k) {
     InstanceErrors& e = result.instances[k];
@@ -209,6 +211,8 @@ DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
   }
   result.raw_rms_error_m = raw_samples > 0 ? std::sqrt(raw_sum_sq / static_cast<double>(raw_samples)) : 0.0;
   pipeline->core().snapshot().load(result.final);
+  // The workers' health after finishing (a mapper's last keyframes).
+  if (Hardware* hw = pipeline->hardware()) hw->fill_snapshot(result.final);
   if (tap) {
     result.recording_lost = tap->overflows();
     if (!pipeline->stop(&error)) {

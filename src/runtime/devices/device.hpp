@@ -49,6 +49,10 @@ class Device {
   // so far: a replay steps the thread until the loop's recorded intake.
   virtual int sensor() const noexcept { return -1; }
   virtual std::int64_t samples() const noexcept { return 0; }
+  // Workers (DeviceScheduling::kWorker), once every thread has stopped:
+  // finish the work the run's last tick made due, so a live run, its replay
+  // and a lockstep drive end in the same state.
+  virtual void finish() noexcept {}
   // Loop thread: its health into its diagnostics slots of the snapshot.
   virtual void fill_snapshot(Snapshot& s) noexcept = 0;
   // Publisher thread: outputs of its own that are for watching, not for the

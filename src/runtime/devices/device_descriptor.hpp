@@ -34,6 +34,11 @@ enum class DeviceScheduling : std::uint8_t {
   kPolled,      // the loop calls poll() inside its tick; its bus calls are the loop's stream
   kThread,      // step() on a thread of its own; its bus calls are the stream of its name
   kHostThread,  // a frame consumer of its host(), called on the host's thread with each pair
+  // A consumer of its host()'s pairs and the loop's estimates that works on
+  // a thread of its own at a lower priority (the mapper): live, step() on
+  // that thread; a replay or a lockstep drive, step(0) after every tick. It
+  // has no buses: what it does must follow from its inputs alone.
+  kWorker,
 };
 
 // A [[sensor]] source a device feeds: `source = "<name>"` in the TOML.
@@ -60,7 +65,7 @@ class DeviceDescriptor {
   virtual const char* name() const noexcept = 0;
   virtual DeviceScheduling scheduling() const noexcept = 0;
   // A frame consumer's source: the device whose rectified pairs it takes
-  // (kHostThread; or kThread for one that works on a thread of its own).
+  // (kHostThread, kWorker).
   virtual const char* host() const noexcept { return nullptr; }
 
   // --- configuration (the loader) --------------------------------------------

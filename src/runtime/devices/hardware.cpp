@@ -54,6 +54,7 @@ std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& co
       case DeviceScheduling::kPolled: h->polled_[h->num_polled_++] = i; break;
       case DeviceScheduling::kThread: h->threaded_[h->num_threaded_++] = i; break;
       case DeviceScheduling::kHostThread: break;
+      case DeviceScheduling::kWorker: h->workers_[h->num_workers_++] = i; break;
     }
     h->devices_[i] = std::move(device);
   }
@@ -80,6 +81,14 @@ void Hardware::fill_snapshot(Snapshot& s) noexcept {
   for (const std::unique_ptr<Device>& d : devices_) {
     if (d) d->fill_snapshot(s);
   }
+}
+
+void Hardware::step_workers() noexcept {
+  for (int i = 0; i < num_workers_; ++i) devices_[workers_[i]]->step(0);
+}
+
+void Hardware::finish_workers() noexcept {
+  for (int i = 0; i < num_workers_; ++i) devices_[workers_[i]]->finish();
 }
 
 void Hardware::publish_due(TimeNs now, transport::MessageSink& sink) noexcept {

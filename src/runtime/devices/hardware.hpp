@@ -44,6 +44,15 @@ class Hardware final : public TickDevices {
   Device& thread_device(int i) noexcept { return *devices_[threaded_[i]]; }
   const char* thread_device_name(int i) const noexcept { return device_type(threaded_[i]).name(); }
 
+  // Workers (DeviceScheduling::kWorker): live, each on a thread of its own
+  // at the default priority; a replay or a lockstep drive calls
+  // step_workers() after every tick and, like the live runtime once its
+  // threads are joined, finish_workers() at the end.
+  int worker_count() const noexcept { return num_workers_; }
+  Device& worker(int i) noexcept { return *devices_[workers_[i]]; }
+  const char* worker_name(int i) const noexcept { return device_type(workers_[i]).name(); }
+  void step_workers() noexcept;
+  void finish_workers() noexcept;
   // The device of that registered name, as the type its descriptor makes;
   // null when the configuration has none (tools and tests).
   template <class T>
@@ -60,6 +69,8 @@ class Hardware final : public TickDevices {
   int num_polled_ = 0;
   int threaded_[kMaxDeviceTypes] = {};
   int num_threaded_ = 0;
+  int workers_[kMaxDeviceTypes] = {};
+  int num_workers_ = 0;
   DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
   int slot_count_ = 0;
 };

@@ -88,6 +88,11 @@ bool Runtime::start(std::string* error, std::string* warnings) {
   for (int i = 0; i < pipeline_->thread_device_count(); ++i) {
     devices_[i] = std::thread(&Runtime::device_thread, this, i);
   }
+  // Workers (the mapper) keep the default policy: below every real-time
+  // thread, so a keyframe never delays the loop, capture or the outputs.
+  if (Hardware* hw = pipeline_->hardware()) {
+    for (int i = 0; i < hw->worker_count(); ++i) workers_[i] = std::thread(&Runtime::worker_thread, this, i);
+  }
   // Set from here, so a refusal is known before start() returns; a thread
   // runs its first microseconds under SCHED_OTHER, which is still start-up.
   std::string io_warnings;
@@ -118,6 +123,11 @@ bool Runtime::stop(std::string* error) {
   for (std::thread& t : devices_) {
     if (t.joinable()) t.join();
   }
+  for (std::thread& t : workers_) {
+    if (t.joinable()) t.join();
+  }
+  // What the last tick made due, as a replay of this run will finish it.
+  if (!stopped_.load() && pipeline_ && pipeline_->hardware() != nullptr) pipeline_->hardware()->finish_workers();
   stopped_.store(true);
   // Producers are gone: the recorder drains what is left and closes.
   return pipeline_ ? pipeline_->stop(error) : true;
@@ -192,6 +202,15 @@ void Runtime::input_thread() {
     // Bounded wait so a stop request is seen within 50 ms.
     lcm_->handle_timeout(50);
   }
+}
+
+void Runtime::worker_thread(int index) {
+  Hardware& hw = *pipeline_->hardware();
+  char name[16];
+  std::snprintf(name, sizeof name, "rtfuse-%s", hw.worker_name(index));
+  name_this_thread(name);
+  Device& worker = hw.worker(index);
+  while (running_.load(std::memory_order_relaxed)) worker.step(kDeviceStepTimeoutNs);
 }
 
 void Runtime::device_thread(int index) {

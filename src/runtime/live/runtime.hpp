@@ -61,6 +61,9 @@ class Runtime {
   // Snapshots the publisher thread could not take in time (ring full).
   std::int64_t publish_drops() const { return publish_drops_.load(std::memory_order_relaxed); }
   const RecordingTap* recording() const { return pipeline_->tap(); }
+  // The devices, for what a tool takes from them after stop() (a mapper's
+  // map); null without any.
+  Hardware* hardware() { return pipeline_->hardware(); }
 
  private:
   // The loop's outputs go to the publisher thread through a ring; a full
@@ -79,6 +82,7 @@ class Runtime {
   void publisher_thread();
   void input_thread();
   void device_thread(int index);
+  void worker_thread(int index);
   static void on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
 
   std::unique_ptr<transport::LcmNode> lcm_;
@@ -97,6 +101,7 @@ class Runtime {
   std::string rt_warnings_;
   std::thread loop_, pub_, lcmin_;
   std::thread devices_[kMaxDeviceTypes];
+  std::thread workers_[kMaxDeviceTypes];
 };
 
 }  // namespace rtfuse

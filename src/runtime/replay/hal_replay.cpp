@@ -80,6 +80,9 @@ class HalReplay {
   void run_ticks(const std::function<void(const HalReplayProgress&)>& progress);
   // What a camera did after the loop's last intake.
   void finish_video();
+  // What the last tick made due, as the live runtime finishes after its
+  // threads stopped.
+  void finish_workers();
   void collect();
 
  private:
@@ -189,6 +192,9 @@ void HalReplay::run_ticks(const std::function<void(const HalReplayProgress&)>& p
     output_->expect(t.published);
     pipeline_->step(t.time_ns, loop_, *output_);
     if (stopped_by_a_stream()) break;
+    // Workers (the mapper) do what this tick made due, as their live thread
+    // did at some later moment: what they do does not depend on when.
+    if (Hardware* hw = pipeline_->hardware()) hw->step_workers();
     ++result_.ticks;
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);
@@ -223,6 +229,10 @@ void HalReplay::finish_video() {
       result_.note = "the recording of " + stream + " ends early: " + log.divergence();
     }
   }
+}
+
+void HalReplay::finish_workers() {
+  if (Hardware* hw = pipeline_->hardware()) hw->finish_workers();
 }
 
 void HalReplay::collect() {
@@ -260,6 +270,7 @@ HalReplayResult replay_hal_recording(const HalRecording& rec, const RuntimeConfi
   if (!replay.set_up(cfg, out)) return result;
   replay.run_ticks(progress);
   replay.finish_video();
+  replay.finish_workers();
   replay.collect();
   return result;
 }
