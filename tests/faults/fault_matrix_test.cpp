@@ -42,8 +42,8 @@ std::string read_file(const std::string& path) {
   return ss.str();
 }
 
-// config/sim.toml without the camera: the TOML blocks [camera], [vo] and
-// the [[sensor]] fed by stereo_vo removed. Rendering the camera costs 99 %
+// config/sim.toml without the camera: the TOML blocks [camera], [vo],
+// [mapping] and the [[sensor]] fed by stereo_vo removed. Rendering the camera costs 99 %
 // of a simulated drive; the rows that do not involve it run without.
 std::string without_camera(const std::string& text) {
   std::string out;
@@ -51,6 +51,7 @@ std::string without_camera(const std::string& text) {
   std::string line, block;
   auto flush = [&] {
     const bool camera = block.rfind("[camera]", 0) == 0 || block.rfind("[vo]", 0) == 0 ||
+                        block.rfind("[mapping]", 0) == 0 ||
                         (block.rfind("[[sensor]]", 0) == 0 && block.find("\"stereo_vo\"") != std::string::npos);
     if (!camera) out += block;
     block.clear();

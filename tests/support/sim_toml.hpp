@@ -13,19 +13,23 @@ namespace rtfuse::test {
 
 inline const std::string kSimTomlPath = RTFUSE_SOURCE_DIR "/config/sim.toml";
 
-inline std::string sim_toml_text(bool with_camera) {
+// The camera's tests keep it; the mapper ([mapping], tens of milliseconds a
+// keyframe) only where a test asks for it.
+inline std::string sim_toml_text(bool with_camera, bool with_mapping = false) {
   std::ifstream in(kSimTomlPath);
   std::stringstream ss;
   ss << in.rdbuf();
   std::string text = ss.str();
-  if (with_camera) return text;
   // From a table's header to the next table header.
-  for (const char* table : {"\n[camera]\n", "\n[vo]\n"}) {
+  const auto erase_table = [&text](const char* table) {
     const std::size_t at = text.find(table);
-    if (at == std::string::npos) continue;
+    if (at == std::string::npos) return;
     const std::size_t next = text.find("\n[", at + 1);
     text.erase(at + 1, next == std::string::npos ? std::string::npos : next - at);
-  }
+  };
+  if (!with_mapping || !with_camera) erase_table("\n[mapping]\n");
+  if (with_camera) return text;
+  for (const char* table : {"\n[camera]\n", "\n[vo]\n"}) erase_table(table);
   // The [[sensor]] the odometry feeds: from its header to the next header.
   const std::size_t source = text.find("source = \"stereo_vo\"");
   if (source != std::string::npos) {

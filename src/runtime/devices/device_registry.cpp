@@ -3,6 +3,7 @@
 #include "runtime/devices/camera/camera_descriptor.hpp"
 #include "runtime/devices/gnss/gnss_descriptor.hpp"
 #include "runtime/devices/imu/imu_descriptor.hpp"
+#include "runtime/devices/mapper/mapper_descriptor.hpp"
 #include "runtime/devices/visual_odometry/visual_odometry_descriptor.hpp"
 #include "runtime/devices/wheel_encoders/wheel_encoders_descriptor.hpp"
 
@@ -16,6 +17,7 @@ const DeviceDescriptor* const kDevices[] = {
     &camera_descriptor(),
     &visual_odometry_descriptor(),
     &gnss_descriptor(),
+    &mapper_descriptor(),
 };
 constexpr int kDeviceCount = static_cast<int>(sizeof(kDevices) / sizeof(kDevices[0]));
 static_assert(kDeviceCount <= kMaxDeviceTypes, "raise kMaxDeviceTypes");
