@@ -41,6 +41,16 @@ BrickStore::BrickStore(BrickCapacity capacity) : capacity_(capacity) {
   clear();
 }
 
+void BrickStore::prefault() noexcept {
+  // Bricks and blocks not handed out yet hold nothing: zeroing them is free
+  // of effect but for the pages it makes resident.
+  std::memset(static_cast<void*>(bricks_.get() + used_bricks_), 0,
+              std::size_t{capacity_.bricks - used_bricks_} * sizeof(Brick));
+  for (std::uint32_t i = 0; i < free_count_; ++i) {
+    std::memset(block_values(free_[i]), 0, kSubVoxels * sizeof(std::uint32_t));
+  }
+}
+
 void BrickStore::clear() noexcept {
   std::memset(table_.get(), 0, (std::size_t{mask_} + 1) * sizeof(std::uint32_t));
   used_bricks_ = 0;

@@ -140,6 +140,10 @@ class BrickStore {
 
   // Forgets every voxel (the pool stays).
   void clear() noexcept;
+  // Writes every page of the pool once, so the memory is resident from
+  // start-up (a daemon's resident size then stays flat while the map grows,
+  // and no page fault lands in a keyframe). Keeps the map.
+  void prefault() noexcept;
 
  private:
   std::uint32_t hash(std::uint64_t key) const noexcept {

@@ -86,6 +86,8 @@ class OccupancyMap {
 
   // Forgets every voxel and count (the pool stays).
   void clear() noexcept;
+  // The pool's pages made resident (BrickStore::prefault), for a daemon.
+  void prefault() noexcept { store_.prefault(); }
 
   // Sets every voxel of the cube of 2^(16 - depth) voxels a side whose
   // lowest corner is `corner` (aligned to the cube's size) to log_odds,

@@ -90,6 +90,8 @@ std::unique_ptr<MapperDevice> MapperDevice::create(FrameSource& camera, FusionCo
     *error = "[mapping]: " + *error;
     return nullptr;
   }
+  // Resident now: the daemon's memory stays flat while the map grows.
+  d->mapper_->map().prefault();
   const int side = static_cast<int>(std::lround(m.grid_size_m / m.resolution_m));
   d->spec_ = mapping::grid_around(d->mapper_->map().grid(), 0.0, 0.0, side, side, m.grid_min_z_m, m.grid_max_z_m);
   const std::size_t cells = d->spec_.cells();
