@@ -212,8 +212,9 @@ def check_cross_arch(tmp):
     # same on both architectures; then the dual EKF with the GNSS receiver
     # (geodesy, the navsat transform, map -> odom) on the 3-minute GNSS loop.
     gnss = ["-s", os.path.join(SRC, "config", "scenarios", "gnss_loop.toml")]
+    digests = set()
     for what, cfg, least, extra in (("demo", write_config(tmp, "demo"), 10000, []),
-                                    ("with frames", product_config(tmp, "straight"), 1000, []),
+                                    ("with frames", product_config(tmp, "straight", mapping_interval=4.0), 1000, []),
                                     ("gnss", os.path.join(SRC, "config", "sim_gnss.toml"), 20000, gnss)):
         for name, sim, rep in (("this->other", SIM, other_replay), ("other->this", other_sim, REPLAY)):
             log = os.path.join(tmp, f"{what.replace(' ', '_')}_{name.replace('->', '_')}.lcm")
@@ -230,6 +231,16 @@ def check_cross_arch(tmp):
                 sys.exit(f"FAIL: {name} {what}: {rec['outputs_identical']} of {rec['outputs_compared']} identical")
             if what == "with frames" and (not vo or vo["motions"] < 500):
                 sys.exit(f"FAIL: {name} {what}: the visual odometry measured too little: {vo}")
+            if what == "with frames":
+                mapper = result["devices"].get("mapper", {})
+                print(f"{name} {what}: mapper {mapper}")
+                if mapper.get("inserted", 0) < 4:
+                    sys.exit(f"FAIL: {name} {what}: the mapper mapped too little: {mapper}")
+                digests.add(mapper["digest"])
+    # The drive simulated on each architecture and replayed on the other:
+    # one map, bit for bit.
+    if len(digests) != 1:
+        sys.exit(f"FAIL: the map differs between the architectures: digests {sorted(digests)}")
 
 
 def device_lines(stdout):
@@ -276,6 +287,20 @@ def check_live_record(tmp):
     # restarts the odometry); what it did, it must do again in the replay.
     if not live_vo or live_vo.get("pairs", 0) < 1 or replayed_vo != live_vo:
         sys.exit("FAIL: the replayed visual odometry differs from the live one")
+    # The mapper's thread ran when the scheduler let it; its map follows from
+    # the pairs and the loop's estimates alone, so the replay, stepping it
+    # after every tick, builds the same one (the digest), unless the live
+    # queue overflowed (dropped), which the replay cannot redo.
+    timing = ("disparity_us", "insert_us", "max_us")
+    live_map = {k: v for k, v in device_lines(p.stdout).get("mapper", {}).items() if k not in timing}
+    replayed_map = {k: v for k, v in result["devices"].get("mapper", {}).items() if k not in timing}
+    print(f"mapper live: {live_map}\nmapper replayed: {replayed_map}")
+    if not live_map or live_map.get("keyframes", 0) < 1:
+        sys.exit(f"FAIL: the live mapper took no keyframe: {p.stdout}")
+    if live_map["dropped"] == 0 and replayed_map != live_map:
+        sys.exit("FAIL: the replayed mapper differs from the live one")
+    if live_map["dropped"] != 0:
+        print(f"note: the live mapper dropped {live_map['dropped']} keyframes (a slow machine): digests not compared")
 
     # A config of its own, whose calibration file is gone when it replays.
     robot = os.path.join(tmp, "robot")
@@ -301,7 +326,7 @@ def check_live_record(tmp):
     print("replayed with the recorded calibration, its file removed:", result["devices"]["camera"]["frames"], "pairs")
 
 
-def product_config(tmp, scenario, camera_fused=True):
+def product_config(tmp, scenario, camera_fused=True, mapping_interval=None):
     """config/sim.toml driving one of config/scenarios, as it is or without
     the camera (its [camera] and [vo] tables and the odometry's [[sensor]])."""
     with open(os.path.join(SRC, "config", "sim.toml")) as f:
@@ -309,6 +334,13 @@ def product_config(tmp, scenario, camera_fused=True):
     text = text.replace('scenario = "scenarios/demo.toml"',
                         'scenario = "%s"' % os.path.join(SRC, "config", "scenarios", scenario + ".toml"))
     text = text.replace('calibration = "calibration/', 'calibration = "%s/' % os.path.join(SRC, "config", "calibration"))
+    if mapping_interval is None:
+        # The mapper costs tens of milliseconds a keyframe: only the checks
+        # about it keep it, at the interval they ask for.
+        at = text.index("\n[mapping]\n")
+        text = text[:at + 1] + text[text.index("\n[", at + 1) + 1:]
+    else:
+        text = text.replace("keyframe_interval = 0.2 ", "keyframe_interval = %g " % mapping_interval)
     if not camera_fused:
         # The camera, its odometry and their sensor go: the drive is the
         # same (lockstep, its own random streams), and rendering frames
@@ -317,7 +349,7 @@ def product_config(tmp, scenario, camera_fused=True):
             at = text.index(table)
             text = text[:at + 1] + text[text.index("\n[", at + 1) + 1:]
         text = text[:text.index("# Visual odometry: the camera")]
-    path = os.path.join(tmp, f"{scenario}_{'vo' if camera_fused else 'novo'}.toml")
+    path = os.path.join(tmp, f"{scenario}_{'vo' if camera_fused else 'novo'}_{mapping_interval or 'nomap'}.toml")
     with open(path, "w") as f:
         f.write(text)
     return path
