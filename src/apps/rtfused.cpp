@@ -18,7 +18,10 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/map_outputs.hpp"
 #include "hal/linux/monotonic_clock.hpp"
+#include "mapping/map_digest.hpp"
+#include "runtime/devices/mapper/mapper_device.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/devices/device_registry.hpp"
 #include "runtime/devices/linux_hal.hpp"
@@ -75,6 +78,42 @@ void truth_thread(rtfuse::sim::SimRobot* robot, rtfuse::transport::LcmNode* lcm,
 }
 
 
+// The mapper's files at exit ([mapping] output or --map-out): the map as
+// it ended, the grid, and the keyframes' path over it. False with the reason.
+bool write_map_files(rtfuse::MapperDevice& mapper, const std::string& prefix, std::string* error) {
+  rtfuse::apps::MapOutputs out;
+  out.prefix = prefix;
+  out.title = "rtfused: the map at exit";
+  for (int i = 0; i < mapper.trajectory_size(); ++i) {
+    out.path.push_back({mapper.trajectory()[i].x, mapper.trajectory()[i].y});
+  }
+  const rtfuse::MapperStats s = mapper.stats();
+  const rtfuse::mapping::OccupancyMap& map = mapper.map();
+  char line[160];
+  out.figures.push_back("# the map");
+  std::snprintf(line, sizeof line, "keyframes   %lld (%lld dropped)", static_cast<long long>(s.inserted),
+                static_cast<long long>(mapper.dropped()));
+  out.figures.push_back(line);
+  std::snprintf(line, sizeof line, "voxels      %.2f cm, range %.1f m", mapper.config().resolution_m * 100.0,
+                mapper.config().max_range_m);
+  out.figures.push_back(line);
+  std::snprintf(line, sizeof line, "known       %llu", static_cast<unsigned long long>(map.known_voxels()));
+  out.figures.push_back(line);
+  std::snprintf(line, sizeof line, "occupied    %llu", static_cast<unsigned long long>(map.occupied_voxels()));
+  out.figures.push_back(line);
+  std::snprintf(line, sizeof line, "memory      %.2f MB", static_cast<double>(map.store().bytes_used()) / 1e6);
+  out.figures.push_back(line);
+  std::snprintf(line, sizeof line, "digest      %016llx",
+                static_cast<unsigned long long>(rtfuse::mapping::map_digest(map)));
+  out.figures.push_back(line);
+  out.figures.push_back("");
+  out.figures.push_back("# the grid");
+  std::snprintf(line, sizeof line, "heights     %.2f to %.2f m", mapper.config().grid_min_z_m,
+                mapper.config().grid_max_z_m);
+  out.figures.push_back(line);
+  return rtfuse::apps::write_map_outputs(map, mapper.grid_spec(), mapper.grid_cells(), out, error);
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -97,6 +136,10 @@ int main(int argc, char** argv) {
   std::string record_path;
   app.add_option("--record", record_path,
                  "write every bus event, loop tick and output to this LCM log (replay it with rtfuse-replay)");
+  std::string map_out;
+  app.add_option("--map-out", map_out,
+                 "with [mapping]: write the map at exit to PREFIX.bt, PREFIX.pgm + .yaml and PREFIX.png "
+                 "(overrides [mapping] output)");
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -121,6 +164,13 @@ int main(int argc, char** argv) {
   }
   rtfuse::RuntimeConfig cfg = *loaded.config;
   if (!lcm_url.empty()) cfg.lcm_url = lcm_url;
+  if (!map_out.empty()) {
+    if (!cfg.hardware.mapping.enabled) {
+      std::fprintf(stderr, "rtfused: --map-out needs a [mapping] section in %s\n", cfg.source.c_str());
+      return 2;
+    }
+    cfg.hardware.mapping.output = map_out;
+  }
   // The embedded config's camera is the one of the embedded calibration.
   if (config_path.empty() && cfg.hardware.camera.enabled) {
     cfg.hardware.camera.calibration_text = rtfuse::apps::kEmbeddedCameraCalibration;
@@ -270,12 +320,27 @@ int main(int argc, char** argv) {
                             static_cast<double>(d.values[k]) / 1000.0);
       }
     }
-    char line[320];
+    // The map growing: keyframes, their rate, known and occupied voxels.
+    char map_text[96] = "";
+    for (int i = 0; i < s.num_devices; ++i) {
+      const rtfuse::DeviceStatus& d = s.devices[i];
+      if (std::strcmp(d.name.c_str(), "mapper") != 0) continue;
+      long long v[4] = {};
+      const char* keys[4] = {"inserted", "rate_milli", "known", "occupied"};
+      for (int k = 0; k < d.num_values; ++k) {
+        for (int j = 0; j < 4; ++j) {
+          if (std::strcmp(d.keys[k], keys[j]) == 0) v[j] = d.values[k];
+        }
+      }
+      std::snprintf(map_text, sizeof map_text, " | map %lld kf %.1f/s %.0fk vox %.0fk occ", v[0], v[1] / 1000.0,
+                    static_cast<double>(v[2]) / 1e3, static_cast<double>(v[3]) / 1e3);
+    }
+    char line[400];
     std::snprintf(line, sizeof(line),
-                  "t=%6.1fs loop %.0f Hz overruns %lld jitter max %.0f us | x %.2f y %.2f yaw %.2f | fused %lld%s%s",
+                  "t=%6.1fs loop %.0f Hz overruns %lld jitter max %.0f us | x %.2f y %.2f yaw %.2f | fused %lld%s%s%s",
                   rtfuse::ns_to_sec(now - start), s.loop.rate_hz, static_cast<long long>(s.loop.overruns),
                   s.loop.jitter_max_ns / 1e3, s.state[0], s.state[1], s.state[5],
-                  static_cast<long long>(s.loop.measurements_fused), rates, err_text);
+                  static_cast<long long>(s.loop.measurements_fused), rates, map_text, err_text);
     std::fprintf(stderr, tty ? "\r%s\033[K" : "%s\n", line);
   }
   if (probe_armed) rtfuse_alloc_probe_steady(0);
@@ -305,6 +370,17 @@ int main(int argc, char** argv) {
                 "samples\n",
                 cfg.instances[static_cast<std::size_t>(k)].name.c_str(), instance_error[k],
                 std::sqrt(instance_sq_sum[k] / static_cast<double>(instance_samples[k])), instance_samples[k]);
+  }
+  rtfuse::MapperDevice* mapper =
+      runtime->hardware() != nullptr ? runtime->hardware()->find<rtfuse::MapperDevice>("mapper") : nullptr;
+  if (mapper != nullptr && !cfg.hardware.mapping.output.empty()) {
+    const std::string& prefix = cfg.hardware.mapping.output;
+    if (!write_map_files(*mapper, prefix, &error)) {
+      std::fprintf(stderr, "rtfused: the map's files: %s\n", error.c_str());
+      return 1;
+    }
+    std::printf("rtfused: map written to %s.bt, %s.pgm + %s.yaml and %s.png\n", prefix.c_str(), prefix.c_str(),
+                prefix.c_str(), prefix.c_str());
   }
   if (!record_path.empty()) {
     if (!recorded) {
