@@ -234,18 +234,20 @@ void MapperDevice::map_keyframe(const FramePool::Frame& f, const geometry::Rigid
   s.disparity_ns = t1 - t0;
   s.insert_ns = t2 - t1;
   if (t2 - t0 > s.max_keyframe_ns) s.max_keyframe_ns = t2 - t0;
-  s.digest = mapping::map_digest(map);
   if (trajectory_size_ < kTrajectoryCapacity) {
     trajectory_[trajectory_size_++] = {f.stamp, world_T_camera.translation.x(), world_T_camera.translation.y()};
   }
-  grid_changed_ = true;
   if (grid_period_ns_ > 0 && f.stamp >= next_grid_) {
-    next_grid_ = f.stamp + grid_period_ns_;
+    // Due times a period apart, like the keyframes', so 1 Hz is 1 Hz.
+    next_grid_ = s.grids == 0 ? f.stamp + grid_period_ns_ : next_grid_ + grid_period_ns_;
+    if (next_grid_ <= f.stamp) next_grid_ = f.stamp + grid_period_ns_;
+    // The digest and the projection walk the whole map: at the grid's rate,
+    // not every keyframe's.
+    s.digest = mapping::map_digest(map);
     Grid& g = grids_.write_buffer();
     project_grid(g.cells.get());
     g.stamp = f.stamp;
     grids_.publish();
-    grid_changed_ = false;
     ++s.grids;
   }
 }
@@ -267,6 +269,7 @@ void MapperDevice::finish() noexcept {
   while (map_due_keyframe()) {
   }
   project_grid(final_cells_.get());
+  stats_.digest = mapping::map_digest(mapper_->map());
   health_.store(stats_);
 }
 

@@ -67,7 +67,7 @@ struct MapperStats {
   TimeNs disparity_ns = 0;       // the last keyframe's disparity and points
   TimeNs insert_ns = 0;          // its insertion
   TimeNs max_keyframe_ns = 0;
-  std::uint64_t digest = 0;      // mapping/map_digest.hpp
+  std::uint64_t digest = 0;      // mapping/map_digest.hpp, at the last grid and at finish()
   TimeNs first_stamp = 0;        // of the keyframes mapped
   TimeNs last_stamp = 0;
 };
@@ -171,7 +171,6 @@ class MapperDevice final : public Device, public FrameConsumer {
   std::unique_ptr<mapping::KeyframeMapper> mapper_;
   mapping::GridSpec spec_;
   TimeNs next_grid_ = 0;
-  bool grid_changed_ = false;
   bool have_last_ = false;
   geometry::RigidTransform last_mapped_;
   std::unique_ptr<KeyframePlace[]> trajectory_;
