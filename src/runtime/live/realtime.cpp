@@ -3,6 +3,9 @@
 #include <pthread.h>
 #include <sched.h>
 #include <sys/mman.h>
+#include <sys/resource.h>
+#include <sys/syscall.h>
+#include <unistd.h>
 
 #include <cerrno>
 #include <cstring>
@@ -63,6 +66,10 @@ RealtimeOutcome apply_io_priority(const RealtimeConfig& rt, pthread_t thread, co
                    std::to_string(rt.priority) + ")\n";
   }
   return out;
+}
+
+void lower_this_thread(int nice_value) {
+  (void)setpriority(PRIO_PROCESS, static_cast<id_t>(syscall(SYS_gettid)), nice_value);
 }
 
 void name_this_thread(const char* name) { pthread_setname_np(pthread_self(), name); }
