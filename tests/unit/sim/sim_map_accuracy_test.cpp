@@ -4,17 +4,22 @@
 // disparity (half resolution, 64 disparities: the live default), textureless
 // pixels dropped, turned into points with the camera's true pose and
 // inserted at 0.05 m with a 6 m range, then the 2-D grid between 0.1 and
-// 2 m. Scored over the drive area's cells the map knows: of those the
-// world holds solid, the share occupied; of the occupied ones, the share
-// the world holds free (strictly, and more than a cell away from any
-// solid). True poses: this scores the depth and the map, not the filter.
+// 2 m. True poses: this scores the depth and the map, not the filter.
 //
-// The issue's target (95 % of the solid cells occupied, at most 2 % of the
-// occupied cells free) is NOT met: at half resolution a matched pixel is
-// 0.2-1.7 m of depth at 2-6 m, so hits fringe the obstacles and scatter in
-// front of them (docs/performance.md, "Map accuracy in simulation"). The bounds
-// below are today's figures with a margin: they catch a regression (a
-// geometry slip put 93 % of the occupied cells in free space), not the goal.
+// The issue's first target, "at least 95 % of the true obstacle cells the
+// camera saw are occupied", is scored as it reads: the cells of the drive
+// area where a surface the camera truly saw lies (each matched pixel's ray
+// cast against the world, within the range and the grid's heights). It is
+// met. Scored instead over every solid cell whose column the map knows, it
+// is not, and cannot be: a box's inside is known from the rays over its
+// top, never seen, and even perfect depth fills only 28 % of those.
+//
+// The second, "at most 2 % of occupied cells are free in truth", is NOT
+// met: at half resolution a matched pixel is 0.2-1.7 m of depth at 2-6 m,
+// so hits scatter in front of and behind the obstacles (docs/performance.md,
+// "Map accuracy in simulation"). The bounds below are today's figures with
+// a margin: they catch a regression (a geometry slip put 93 % of the
+// occupied cells in free space), not the goal.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -30,6 +35,7 @@
 #include "sim/path_plan.hpp"
 #include "sim/stereo_renderer.hpp"
 #include "support/pinhole_stereo.hpp"
+#include "support/world_depth.hpp"
 #include "vision/semi_global_matcher.hpp"
 #include "vision/texture_filter.hpp"
 
@@ -85,6 +91,9 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
   vision::Plane<std::uint16_t> disparity(matcher.output_width(kW), matcher.output_height(kH));
   std::vector<mapping::MapPoint> points(static_cast<std::size_t>(disparity.width()) * disparity.height());
   const vision::StereoCameraModel camera{kF, kCx, kCy, kBaseline};
+  // The world points the camera truly saw through each matched pixel,
+  // within the range (the "seen" of the first target).
+  std::vector<Eigen::Vector3d> seen_points;
   int frames = 0;
   for (double t = 0.0; t <= plan.end_time(); t += 2.0, ++frames) {
     const sim::PathPoint p = plan.at(t);
@@ -97,6 +106,14 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
       for (int x = 0; x < kW; ++x) {
         left.row(y)[x] = frame[static_cast<std::size_t>(y) * bpl + 2 * static_cast<std::size_t>(x)];
         right.row(y)[x] = frame[static_cast<std::size_t>(y) * bpl + 2 * static_cast<std::size_t>(kW + x)];
+      }
+    }
+    for (int v = 0; v < disparity.height(); ++v) {
+      for (int u = 0; u < disparity.width(); ++u) {
+        const double pu = dp.downscale * u + 0.5 * (dp.downscale - 1), pv = dp.downscale * v + 0.5 * (dp.downscale - 1);
+        const double z = test::true_depth(world, world_T_camera, kF, kCx, kCy, pu, pv);
+        const Eigen::Vector3d in_camera((pu - kCx) * z / kF, (pv - kCy) * z / kF, z);
+        if (std::isfinite(z) && in_camera.norm() <= 6.0) seen_points.push_back(world_T_camera * in_camera);
       }
     }
     ASSERT_EQ(matcher.compute(vision::view_of(left), vision::view_of(right), vision::view_of(disparity)),
@@ -132,6 +149,33 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
     const double side = (2 * r + 1) * mp.resolution;
     return world.solid_in(bx, by, bx + side, by + side, spec.z_min, spec.z_max);
   };
+  // The first target: of the cells where a surface the camera saw lies,
+  // the share occupied.
+  std::vector<std::uint8_t> seen(spec.cells(), 0);
+  for (const Eigen::Vector3d& q : seen_points) {
+    if (q.z() < spec.z_min || q.z() > spec.z_max) continue;
+    const int i = static_cast<int>(std::floor((q.x() - x0) / mp.resolution));
+    const int j = static_cast<int>(std::floor((q.y() - y0) / mp.resolution));
+    if (i >= 0 && j >= 0 && i < spec.width && j < spec.height) {
+      seen[static_cast<std::size_t>(j) * static_cast<std::size_t>(spec.width) + static_cast<std::size_t>(i)] = 1;
+    }
+  }
+  int cells_seen = 0, seen_occupied = 0;
+  for (int j = 0; j < spec.height; ++j) {
+    for (int i = 0; i < spec.width; ++i) {
+      if (!seen[static_cast<std::size_t>(j) * static_cast<std::size_t>(spec.width) + static_cast<std::size_t>(i)]) {
+        continue;
+      }
+      ++cells_seen;
+      seen_occupied += cell_at(i, j) == mapping::kCellOccupied;
+    }
+  }
+  ASSERT_GT(cells_seen, 200);  // the course's obstacles were in view
+  const double seen_recall = static_cast<double>(seen_occupied) / cells_seen;
+  std::printf("%d obstacle cells the camera saw: %.1f %% occupied (the issue: at least 95 %%)\n", cells_seen,
+              100.0 * seen_recall);
+  EXPECT_GE(seen_recall, 0.95);
+
   // Strictly, and within a cell: a face on a cell line leaves its fringe of
   // hits one cell out, and a face cell seen past at a slant is carved free.
   int solid_seen = 0, solid_occupied = 0, solid_occupied_near = 0, occupied = 0, occupied_free = 0,
@@ -167,7 +211,8 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
               frames, static_cast<unsigned long long>(map.known_voxels()),
               static_cast<unsigned long long>(map.occupied_voxels()), solid_seen, 100.0 * recall,
               100.0 * recall_near, occupied, 100.0 * false_share, 100.0 * far_share);
-  // Today (4 paths): 66 % (87 % within a cell) and 61 % (50 %); the issue asks 95 % and 2 %.
+  // Today (4 paths): 66 % (87 % within a cell) and 61 % (50 %) over every
+  // known solid cell; the issue asks at most 2 % free.
   EXPECT_GE(recall, 0.60);
   EXPECT_GE(recall_near, 0.84);
   EXPECT_LE(false_share, 0.68);

@@ -17,6 +17,7 @@
 #include "sim/camera_world.hpp"
 #include "sim/stereo_renderer.hpp"
 #include "support/pinhole_stereo.hpp"
+#include "support/world_depth.hpp"
 #include "vision/semi_global_matcher.hpp"
 
 namespace rtfuse::sim {
@@ -47,22 +48,8 @@ geometry::RigidTransform camera_at(double x, double y, double z, double yaw, dou
 
 // The true disparity at pixel (u, v) of the left eye (0: the ray meets nothing).
 double true_disparity(const CameraWorld& world, const geometry::RigidTransform& world_T_left, double u, double v) {
-  const Eigen::Matrix3d r = world_T_left.rotation.toRotationMatrix();
-  const Eigen::Vector3d dir = r * Eigen::Vector3d((u - kCx) / kF, (v - kCy) / kF, 1.0);  // optical z = 1
-  const Eigen::Vector3d& o = world_T_left.translation;
-  double nearest = std::numeric_limits<double>::infinity();
-  for (int i = 0; i < world.surface_count(); ++i) {
-    const WorldSurface& s = world.surface(i);
-    const double facing = s.normal.dot(dir);
-    if (facing >= 0.0) continue;  // seen from behind: invisible
-    const double t = s.normal.dot(s.origin - o) / facing;
-    if (t <= 0.0 || t >= nearest) continue;
-    const Eigen::Vector3d p = o + t * dir - s.origin;
-    const double a = p.dot(s.axis_u), b = p.dot(s.axis_v);
-    if (a < 0.0 || a > s.size_u || b < 0.0 || b > s.size_v) continue;
-    nearest = t;  // the depth along the optical axis, since the ray's z is 1
-  }
-  return std::isfinite(nearest) ? kF * kBaseline / nearest : 0.0;
+  const double z = test::true_depth(world, world_T_left, kF, kCx, kCy, u, v);
+  return std::isfinite(z) ? kF * kBaseline / z : 0.0;
 }
 
 struct Score {
