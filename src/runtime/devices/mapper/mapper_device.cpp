@@ -51,8 +51,8 @@ mapping::KeyframeMapperParams mapper_params(const MappingSection& m) {
 
 }  // namespace
 
-MapperDevice::MapperDevice(FusionCore& core, FrameSource& camera, int slot)
-    : core_(core), camera_(camera), slot_(slot), poses_(kPoseRing), history_(kPoseHistory) {}
+MapperDevice::MapperDevice(FrameSource& camera, int slot)
+    : camera_(camera), slot_(slot), poses_(kPoseRing), history_(kPoseHistory) {}
 
 MapperDevice::~MapperDevice() {
   // Pairs still queued go back to the camera's pool, which outlives us.
@@ -78,7 +78,7 @@ std::unique_ptr<MapperDevice> MapperDevice::create(FrameSource& camera, FusionCo
              "; depth from disparity needs square pixels";
     return nullptr;
   }
-  std::unique_ptr<MapperDevice> d(new MapperDevice(core, camera, slot));
+  std::unique_ptr<MapperDevice> d(new MapperDevice(camera, slot));
   d->config_ = m;
   d->base_T_camera_ = *mount;
   d->interval_ns_ = seconds_ns(m.keyframe_interval_s);

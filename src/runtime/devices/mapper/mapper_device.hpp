@@ -137,7 +137,7 @@ class MapperDevice final : public Device, public FrameConsumer {
   using LoopPose = mapper_detail::LoopPose;
   using Grid = mapper_detail::Grid;
 
-  MapperDevice(FusionCore& core, FrameSource& camera, int slot);
+  MapperDevice(FrameSource& camera, int slot);
   void take_poses() noexcept;
   // The first queued keyframe, if the loop is pose_delay past it: mapped,
   // or dropped with its reason. False when none is due.
@@ -145,7 +145,6 @@ class MapperDevice final : public Device, public FrameConsumer {
   void map_keyframe(const FramePool::Frame& f, const geometry::RigidTransform& world_T_base) noexcept;
   void project_grid(std::int8_t* cells) noexcept;
 
-  FusionCore& core_;
   FrameSource& camera_;
   int slot_ = -1;
   MappingSection config_;
