@@ -14,32 +14,15 @@
 #include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
 #include "sim/sim_drive.hpp"
+#include "support/device_values.hpp"
 #include "support/sim_toml.hpp"
 #include "transport/event_log.hpp"
 
 namespace mapper_drive_test {
 using namespace rtfuse;  // NOLINT
-
-std::string errors(const ConfigLoadResult& r) {
-  std::string all;
-  for (const ConfigError& e : r.errors) all += e.to_string() + "\n";
-  return all;
-}
-
-const DeviceStatus* find_device(const Snapshot& s, const char* name) {
-  for (int i = 0; i < s.num_devices; ++i) {
-    if (std::string(s.devices[i].name.c_str()) == name) return &s.devices[i];
-  }
-  return nullptr;
-}
-
-std::int64_t value(const DeviceStatus& d, const char* key) {
-  for (int i = 0; i < d.num_values; ++i) {
-    if (std::string(d.keys[i]) == key) return d.values[i];
-  }
-  ADD_FAILURE() << "no key " << key;
-  return -1;
-}
+using test::find_device;
+std::string errors(const ConfigLoadResult& r) { return test::config_errors(r); }
+std::int64_t value(const DeviceStatus& d, const char* key) { return test::device_value(d, key); }
 
 std::string replaced(std::string text, const std::string& from, const std::string& to) {
   const std::size_t at = text.find(from);

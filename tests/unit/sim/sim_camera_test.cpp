@@ -25,11 +25,15 @@
 #include "sim/sim_drive.hpp"
 #include "transport/event_log.hpp"
 #include "transport/hal_record_codec.hpp"
+#include "support/device_values.hpp"
 #include "support/sim_toml.hpp"
 
 namespace sim_camera_test {
 
 using namespace rtfuse;  // NOLINT
+using test::find_device;
+std::string errors(const ConfigLoadResult& r) { return test::config_errors(r); }
+std::int64_t value(const DeviceStatus& d, const char* key) { return test::device_value(d, key); }
 
 const std::string kSimToml = std::string(RTFUSE_SOURCE_DIR) + "/config/sim.toml";
 
@@ -48,27 +52,6 @@ std::string sim_toml() { return test::sim_toml_text(false); }
 ConfigLoadResult load(const std::string& extra) {
   // Named after config/sim.toml so its relative paths (scenario, calibration) resolve from config/.
   return load_config_string(sim_toml() + extra, kSimToml);
-}
-
-std::string errors(const ConfigLoadResult& r) {
-  std::string all;
-  for (const ConfigError& e : r.errors) all += e.to_string() + "\n";
-  return all;
-}
-
-const DeviceStatus* find_device(const Snapshot& s, const char* name) {
-  for (int i = 0; i < s.num_devices; ++i) {
-    if (std::string(s.devices[i].name.c_str()) == name) return &s.devices[i];
-  }
-  return nullptr;
-}
-
-std::int64_t value(const DeviceStatus& d, const char* key) {
-  for (int i = 0; i < d.num_values; ++i) {
-    if (std::string(d.keys[i]) == key) return d.values[i];
-  }
-  ADD_FAILURE() << "no key " << key;
-  return -1;
 }
 
 TEST(SimCamera, LockstepDriveRectifiesEveryFrameAtTheConfiguredRate) {
