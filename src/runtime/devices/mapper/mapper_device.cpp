@@ -146,7 +146,12 @@ void MapperDevice::fill_snapshot(Snapshot& s) noexcept {
   health_.load(v);
   const std::int64_t permille = v.bricks_capacity > 0 ? v.bricks_used * 1000 / v.bricks_capacity : 0;
   const TimeNs span = v.last_stamp - v.first_stamp;
-  const std::int64_t rate_milli = v.inserted > 1 && span > 0 ? (v.inserted - 1) * 1'000'000'000'000 / span : 0;
+  // In floating point: (inserted - 1) * 1e12 would overflow an int64 after
+  // three weeks of mapping at 5 a second.
+  const std::int64_t rate_milli =
+      v.inserted > 1 && span > 0
+          ? std::llround(static_cast<double>(v.inserted - 1) * 1e12 / static_cast<double>(span))
+          : 0;
   DeviceStatus& d = s.devices[slot_];
   set_device_values(d, kMapperKeys,
                     {candidates_.load(std::memory_order_relaxed), v.inserted, dropped_.load(std::memory_order_relaxed),
