@@ -68,7 +68,7 @@ fi
 cd "$dir"
 # What the emulation proves, and only that: the unit tests on the target's
 # instruction set (every layer's arithmetic, the SIMD paths on NEON), the
-# recordings crossing the two architectures both ways (integration_cross_arch,
+# recordings crossing the two architectures both ways (integration_cross_arch_*,
 # label cross_arch: every output byte-identical), and the arm64 package in a
 # clean arm64 root. The other integration and system tests replay, drive and
 # publish through the same code the unit tests and the cross-architecture
@@ -81,7 +81,7 @@ cd "$dir"
 # - the simulated camera's two lockstep drives (rendering and rectifying
 #   every frame: 206 s of test time under emulation, the longest after the
 #   package install): the arithmetic they exercise is integer, and
-#   integration_cross_arch replays a drive with frames across the two
+#   integration_cross_arch_frames replays a drive with frames across the two
 #   architectures, every rectified pair compared, which is what this stage
 #   is for.
 # - the slow second frame consumer (a minute under emulation, the longest
