@@ -12,7 +12,7 @@
 // cast against the world, within the range and the grid's heights). It is
 // met. Scored instead over every solid cell whose column the map knows, it
 // is not, and cannot be: a box's inside is known from the rays over its
-// top, never seen, and even perfect depth fills only 28 % of those.
+// top and never seen.
 //
 // The second, "at most 2 % of occupied cells are free in truth", is NOT
 // met: at half resolution a matched pixel is 0.2-1.7 m of depth at 2-6 m,
