@@ -7,6 +7,7 @@
 // is given in voxel keys and no coordinate is rounded twice.
 #include <cstddef>
 #include <cstdint>
+#include <memory>
 
 #include "mapping/occupancy_map.hpp"
 
@@ -45,5 +46,32 @@ struct ProjectionCounts {
 // map's bricks, not in the grid's cells: a brick outside the grid or the
 // heights costs a comparison.
 ProjectionCounts project_to_grid(const OccupancyMap& map, const GridSpec& spec, std::int8_t* cells) noexcept;
+
+// The same grid kept up to date: note_scan() after each insert_scan marks
+// the grid's brick columns (8 x 8 cells) the scan wrote, refresh()
+// projects those columns again from their bricks, each once however many
+// scans wrote it. Its cost is what the scans since the last refresh
+// touched, not the map.
+class ProjectedGrid {
+ public:
+  // Allocates here, never after. Starts as the map's projection now.
+  ProjectedGrid(const OccupancyMap& map, const GridSpec& spec);
+
+  // After every insert_scan into the map (a scan missed is a grid wrong).
+  void note_scan(const OccupancyMap& map) noexcept;
+  // The grid of the map now: spec().cells() cells as project_to_grid's.
+  const std::int8_t* refresh(const OccupancyMap& map) noexcept;
+
+  const GridSpec& spec() const noexcept { return spec_; }
+
+ private:
+  GridSpec spec_;
+  int column_x0_ = 0, column_y0_ = 0;  // brick coordinates of column 0
+  int columns_x_ = 0, columns_y_ = 0;
+  std::unique_ptr<std::int8_t[]> cells_;
+  std::unique_ptr<std::uint32_t[]> dirty_;  // columns to project again, each once
+  std::unique_ptr<std::uint8_t[]> is_dirty_;
+  std::uint32_t dirty_count_ = 0;
+};
 
 }  // namespace rtfuse::mapping

@@ -255,7 +255,6 @@ void OccupancyMap::compact_touched() noexcept {
       store_.release_block(block);
     }
   }
-  touched_count_ = 0;
 }
 
 }  // namespace rtfuse::mapping

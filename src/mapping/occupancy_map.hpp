@@ -60,6 +60,12 @@ class OccupancyMap {
   const VoxelGrid& grid() const noexcept { return grid_; }
   const BrickStore& store() const noexcept { return store_; }
 
+  // The bricks the last insert_scan wrote (indices into store()), each
+  // once, until the next scan or clear(): what a digest or a grid kept up
+  // to date scan by scan has to look at again.
+  const std::uint32_t* scan_bricks() const noexcept { return touched_.get(); }
+  std::uint32_t scan_brick_count() const noexcept { return touched_count_; }
+
   // visit(const VoxelKey&, float log_odds) for every known voxel, brick by
   // brick in the order they were made (deterministic, not sorted).
   template <class Visit>
