@@ -4,7 +4,6 @@
 #include <cmath>
 
 #include "geometry/rotation.hpp"
-#include "mapping/map_digest.hpp"
 #include "transport/occupancy_grid_message.hpp"
 
 namespace rtfuse {
@@ -98,6 +97,8 @@ std::unique_ptr<MapperDevice> MapperDevice::create(FrameSource& camera, FusionCo
   for (int i = 0; i < 3; ++i) d->grids_.buffer(i).cells.reset(new std::int8_t[cells]);
   d->final_cells_.reset(new std::int8_t[cells]);
   std::fill(d->final_cells_.get(), d->final_cells_.get() + cells, mapping::kCellUnknown);
+  d->digest_.reset(new mapping::MapDigest(d->mapper_->map()));
+  d->grid_.reset(new mapping::ProjectedGrid(d->mapper_->map(), d->spec_));
   d->trajectory_.reset(new KeyframePlace[kTrajectoryCapacity]);
   if (d->grid_period_ns_ > 0) {
     d->encoder_ = transport::OccupancyGridEncoder::create(static_cast<int>(cells),
@@ -223,6 +224,8 @@ void MapperDevice::map_keyframe(const FramePool::Frame& f, const geometry::Rigid
     return;
   }
   mapper_->insert();
+  digest_->note_scan(mapper_->map());
+  grid_->note_scan(mapper_->map());
   const TimeNs t2 = monotonic_now_ns();
   have_last_ = true;
   last_mapped_ = world_T_base;
@@ -246,19 +249,14 @@ void MapperDevice::map_keyframe(const FramePool::Frame& f, const geometry::Rigid
     // Due times a period apart, like the keyframes', so 1 Hz is 1 Hz.
     next_grid_ = s.grids == 0 ? f.stamp + grid_period_ns_ : next_grid_ + grid_period_ns_;
     if (next_grid_ <= f.stamp) next_grid_ = f.stamp + grid_period_ns_;
-    // The digest and the projection walk the whole map: at the grid's rate,
-    // not every keyframe's.
-    s.digest = mapping::map_digest(map);
+    s.digest = digest_->refresh(map);
     Grid& g = grids_.write_buffer();
-    project_grid(g.cells.get());
+    const std::int8_t* cells = grid_->refresh(map);
+    std::copy(cells, cells + spec_.cells(), g.cells.get());
     g.stamp = f.stamp;
     grids_.publish();
     ++s.grids;
   }
-}
-
-void MapperDevice::project_grid(std::int8_t* cells) noexcept {
-  mapping::project_to_grid(mapper_->map(), spec_, cells);
 }
 
 void MapperDevice::step(TimeNs timeout_ns) noexcept {
@@ -273,8 +271,9 @@ void MapperDevice::finish() noexcept {
   take_poses();
   while (map_due_keyframe()) {
   }
-  project_grid(final_cells_.get());
-  stats_.digest = mapping::map_digest(mapper_->map());
+  const std::int8_t* cells = grid_->refresh(mapper_->map());
+  std::copy(cells, cells + spec_.cells(), final_cells_.get());
+  stats_.digest = digest_->refresh(mapper_->map());
   health_.store(stats_);
 }
 

@@ -13,8 +13,10 @@
 //                  keyframe, once the loop is pose_delay past its stamp,
 //                  placed with the pose at its stamp as the loop had it
 //                  then, its disparity turned into points and inserted
-//                  (mapping/keyframe_mapper.hpp); the 2-D grid projected at
-//                  grid_rate into a triple buffer.
+//                  (mapping/keyframe_mapper.hpp); at grid_rate the map's
+//                  digest and 2-D grid brought up to date from the bricks
+//                  the keyframes since wrote (their work, however large
+//                  the map), the grid into a triple buffer.
 //   publisher      publish_due(): the newest grid as occupancy_grid_t.
 //
 // What it maps depends on the pairs lent and the loop's estimates only,
@@ -38,6 +40,7 @@
 #include "geometry/rigid_transform.hpp"
 #include "mapping/grid_projection.hpp"
 #include "mapping/keyframe_mapper.hpp"
+#include "mapping/map_digest.hpp"
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/frame_consumer.hpp"
 #include "runtime/fusion/fusion_core.hpp"
@@ -143,7 +146,6 @@ class MapperDevice final : public Device, public FrameConsumer {
   // or dropped with its reason. False when none is due.
   bool map_due_keyframe() noexcept;
   void map_keyframe(const FramePool::Frame& f, const geometry::RigidTransform& world_T_base) noexcept;
-  void project_grid(std::int8_t* cells) noexcept;
 
   FrameSource& camera_;
   int slot_ = -1;
@@ -174,6 +176,8 @@ class MapperDevice final : public Device, public FrameConsumer {
   geometry::RigidTransform last_mapped_;
   std::unique_ptr<KeyframePlace[]> trajectory_;
   int trajectory_size_ = 0;
+  std::unique_ptr<mapping::MapDigest> digest_;  // kept up to date from the keyframes' bricks
+  std::unique_ptr<mapping::ProjectedGrid> grid_;  // likewise
   std::unique_ptr<std::int8_t[]> final_cells_;
   MapperStats stats_;
   SeqLock<MapperStats> health_;
