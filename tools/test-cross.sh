@@ -41,7 +41,7 @@ cmake -S "$root" -B "$dir" -G Ninja \
 # What this stage runs, and only that: the unit tests, and what the package
 # holds (its programs are the ones the cross-architecture replay runs).
 targets=(rtfuse_deb_inputs)
-for layer in core hal drivers geometry vision estimation mapping transport runtime sim apps; do
+for layer in core hal drivers geometry vision estimation mapping navigation transport runtime sim apps; do
   targets+=("rtfuse_unit_$layer")
 done
 cmake --build "$dir" -j"$(nproc)" --target "${targets[@]}"
