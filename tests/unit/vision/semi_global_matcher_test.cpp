@@ -2,7 +2,8 @@
 // known exactly: a textured plane shifted by an integer and by a fraction,
 // a slanted plane, a foreground square whose occlusion band the left-right
 // check must remove; the invalid border; bad input refused without a crash;
-// the same bytes twice and from every backend; no allocation per frame.
+// the same bytes twice and from every backend, a digest of 48
+// configurations that must not change; no allocation per frame.
 #include "vision/semi_global_matcher.hpp"
 
 #include <gtest/gtest.h>
@@ -15,6 +16,7 @@
 #include <random>
 #include <vector>
 
+#include "core/xxh64.hpp"
 #include "support/alloc_counter.hpp"
 #include "vision/census_cost.hpp"
 #include "vision/census_transform.hpp"
@@ -382,6 +384,100 @@ TEST(SemiGlobalMatcher, PackedSelectionMatchesTwoPassSelection) {
     }
   }
   EXPECT_FALSE(packed_winner_fits(728, 128));  // the matcher selects in two passes then
+}
+
+// The digest's pairs: a texture of grey levels on a 3 px lattice, bilinear
+// between them in integers, over a plane slanting from lo to hi px with a
+// box in front at 1.25 hi, and +-2 grey levels of noise in each eye.
+struct SizedPair {
+  Plane<std::uint8_t> left, right;
+};
+
+SizedPair digest_pair(int w, int h, int lo, int hi, std::uint32_t seed) {
+  std::mt19937 rng(seed);
+  const int cell = 3, gw = (w + 2 * hi) / cell + 3, gh = h / cell + 3;
+  std::vector<int> grid(static_cast<std::size_t>(gw) * static_cast<std::size_t>(gh));
+  for (int& g : grid) g = static_cast<int>(rng() % 256);
+  auto tex = [&](int u16, int v) {
+    const int gu = u16 / (16 * cell), fu = u16 % (16 * cell), gv = v / cell, fv = v % cell;
+    auto g = [&](int i, int j) { return grid[static_cast<std::size_t>(j) * static_cast<std::size_t>(gw) + static_cast<std::size_t>(i)]; };
+    const int top = g(gu, gv) * (16 * cell - fu) + g(gu + 1, gv) * fu;
+    const int bottom = g(gu, gv + 1) * (16 * cell - fu) + g(gu + 1, gv + 1) * fu;
+    return (top * (cell - fv) + bottom * fv) / (16 * cell * cell);
+  };
+  auto clamp = [](int v) { return static_cast<std::uint8_t>(std::clamp(v, 0, 255)); };
+  SizedPair p{Plane<std::uint8_t>(w, h), Plane<std::uint8_t>(w, h)};
+  for (int y = 0; y < h; ++y) {
+    for (int x = 0; x < w; ++x) {
+      const bool box = x > w / 3 && x < w / 2 && y > h / 4 && y < 3 * h / 4;
+      const int d16 = box ? 16 * hi + 16 * (hi / 4) : 16 * lo + 16 * (hi - lo) * x / w;
+      const int noise_left = static_cast<int>(rng() % 5) - 2, noise_right = static_cast<int>(rng() % 5) - 2;
+      p.left.row(y)[x] = clamp(tex(16 * (x + hi + 2), y) + noise_left);
+      p.right.row(y)[x] = clamp(tex(16 * (x + hi + 2) + d16, y) + noise_right);
+    }
+  }
+  return p;
+}
+
+constexpr int kDigestW = 333, kDigestH = 61;  // odd sizes: no row a multiple of a vector
+
+struct DigestCase {
+  DisparityParams params;
+  std::uint32_t seed;
+};
+
+// 48 configurations: 4 and 8 paths, full and half resolution, 16 to 256
+// disparities, P2 60 and 96 (the fused selection and the two-pass one),
+// and P1, uniqueness, the left-right check and the speckle filter varied
+// along.
+std::vector<DigestCase> digest_cases() {
+  std::vector<DigestCase> cases;
+  int i = 0;
+  for (const int paths : {4, 8}) {
+    for (const int downscale : {1, 2}) {
+      for (const int disparities : {16, 32, 48, 64, 96, 128, 256}) {
+        for (const int p2 : {60, 96}) {
+          if (disparities % (16 * downscale) != 0) continue;
+          DisparityParams p;
+          p.paths = paths;
+          p.downscale = downscale;
+          p.disparities = disparities;
+          p.p2 = p2;
+          p.p1 = i % 3 == 0 ? 5 : 9;
+          p.uniqueness_percent = i % 4 == 1 ? 0 : 10;
+          p.lr_max_diff = i % 5 == 2 ? -1 : (i % 5 == 3 ? 0 : 1);
+          p.speckle_window = i % 6 == 4 ? 0 : 100;
+          cases.push_back({p, static_cast<std::uint32_t>(100 + i)});
+          ++i;
+        }
+      }
+    }
+  }
+  return cases;
+}
+
+// The disparities of one case, kDigestW x h.
+Plane<std::uint16_t> match_case(const DigestCase& c, int h) {
+  const SizedPair p = digest_pair(kDigestW, h, c.params.disparities / 8, c.params.disparities / 2, c.seed);
+  SemiGlobalMatcher m(kDigestW, h, c.params);
+  EXPECT_TRUE(m.valid()) << m.error();
+  Plane<std::uint16_t> out(m.output_width(kDigestW), m.output_height(h));
+  EXPECT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(out)), DisparityStatus::kOk);
+  return out;
+}
+
+// The digest of every configuration's disparities: the same from the SSE2,
+// plain and NEON builds, and to stay so whatever the loops become.
+TEST(SemiGlobalMatcher, DigestOfConfigurationsUnchanged) {
+  Xxh64 all;
+  for (const DigestCase& c : digest_cases()) {
+    const Plane<std::uint16_t> out = match_case(c, kDigestH);
+    Xxh64 one;
+    for (int y = 0; y < out.height(); ++y) one.update(out.row(y), static_cast<std::size_t>(out.width()) * 2);
+    const std::uint64_t digest = one.digest();
+    all.update(&digest, sizeof digest);  // little-endian on both architectures
+  }
+  EXPECT_EQ(all.digest(), 0x2a6a144db57688ecULL);
 }
 
 // Sums too wide to pack with their disparity (a larger P2 and range) take
