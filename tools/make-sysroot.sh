@@ -41,6 +41,8 @@ packages=(
   libxxhash-dev
   # PCG32, header-only (src/vision/stereo_egomotion.cpp)
   libpcg-cpp-dev
+  # map_server YAML files (src/apps/map_server_map.cpp, rtfuse-plan)
+  libyaml-cpp0.7 libyaml-cpp-dev
 )
 
 mkdir -p "$dir"

@@ -17,6 +17,8 @@ packages=(
   linux-libc-dev libgpiod-dev
   # the stereo PNG writer of the snapshot tool (src/apps/stereo_png.cpp)
   libpng-dev
+  # map_server YAML files (src/apps/map_server_map.cpp: rtfuse-plan loads maps)
+  libyaml-cpp-dev
   # XXH64, inlined (the camera's digest of its rectified pairs, src/core/xxh64.hpp)
   libxxhash-dev
   # PCG32, header-only: the visual odometry's deterministic RANSAC (src/vision)
