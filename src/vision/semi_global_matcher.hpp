@@ -45,13 +45,25 @@ enum class DisparityStatus : std::uint8_t {
 
 const char* to_string(DisparityStatus s) noexcept;
 
+// The instructions the matcher's loops run on. Integer lanes have one
+// right answer, so every backend gives the same disparities, bit for bit.
+enum class DisparityBackend : std::uint8_t {
+  kAuto,      // the fastest this CPU runs: kBaseline
+  kBaseline,  // the build's baseline vectors: SSE2 on x86-64, NEON on aarch64 (plain lanes if neither)
+  kPlain,     // plain C++ lanes, the definition the others are tested against
+};
+
+const char* to_string(DisparityBackend b) noexcept;
+
 class SemiGlobalMatcher {
  public:
   // For input images of at most max_width x max_height pixels. Check
   // valid(): sizes <= 0, a bad downscale, path count, disparity count (not
   // a multiple of 8 * downscale, or not narrower than max_width) or penalty
-  // are refused with error() saying which and what would do.
-  SemiGlobalMatcher(int max_width, int max_height, const DisparityParams& params = {});
+  // are refused with error() saying which and what would do. backend: see
+  // DisparityBackend; the default takes the fastest this CPU runs.
+  SemiGlobalMatcher(int max_width, int max_height, const DisparityParams& params = {},
+                    DisparityBackend backend = DisparityBackend::kAuto);
   ~SemiGlobalMatcher();
   SemiGlobalMatcher(const SemiGlobalMatcher&) = delete;
   SemiGlobalMatcher& operator=(const SemiGlobalMatcher&) = delete;
@@ -59,6 +71,8 @@ class SemiGlobalMatcher {
   bool valid() const noexcept { return error_ == nullptr; }
   const char* error() const noexcept { return error_; }
   const DisparityParams& params() const noexcept { return params_; }
+  // The backend compute() runs on (never kAuto once valid()).
+  DisparityBackend backend() const noexcept { return backend_; }
 
   // The output's size for an input of width x height: the input's divided
   // by the downscale (an odd last column or row dropped).
@@ -74,15 +88,13 @@ class SemiGlobalMatcher {
 
  private:
   struct Workspace;
-  template <class B, int kPaths, bool kFused>
-  void aggregate(int w, int h) noexcept;
-  void census_costs(int y, int w) noexcept;
   void match(const GreyView& left, const GreyView& right, const DisparityImage& out) noexcept;
 
   DisparityParams params_;
   const char* error_ = nullptr;
   int max_width_ = 0, max_height_ = 0;  // matched (downscaled) pixels
   int disparities_ = 0;                 // matched pixels
+  DisparityBackend backend_ = DisparityBackend::kAuto;
   std::unique_ptr<Workspace> ws_;
   int valid_pixels_ = 0;
 };

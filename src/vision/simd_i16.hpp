@@ -16,6 +16,7 @@ namespace rtfuse::vision::simd {
 
 // The definition the vector backends must agree with.
 struct PlainI16 {
+  static constexpr int kLanes = 8;
   struct V {
     std::int16_t x[8];
   };
@@ -90,6 +91,7 @@ struct PlainI16 {
 
 #if defined(__SSE2__)
 struct NativeI16 {
+  static constexpr int kLanes = 8;
   using V = __m128i;
   static V load(const std::int16_t* p) noexcept { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
   static void store(std::int16_t* p, V a) noexcept { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a); }
@@ -118,6 +120,7 @@ struct NativeI16 {
 constexpr bool kNativeIsVector = true;
 #elif defined(__ARM_NEON)
 struct NativeI16 {
+  static constexpr int kLanes = 8;
   using V = int16x8_t;
   static V load(const std::int16_t* p) noexcept { return vld1q_s16(p); }
   static void store(std::int16_t* p, V a) noexcept { vst1q_s16(p, a); }

@@ -1,8 +1,9 @@
 #pragma once
 // Sixteen unsigned 8-bit lanes for the census and aggregation loops
-// (census_transform.cpp, census_cost.cpp, semi_global_matcher.cpp): SSE2 on x86-64, NEON on aarch64, a plain array
-// everywhere, as simd_i16.hpp does for 16-bit lanes. Integer lanes have one
-// right answer, so every backend gives the same bytes.
+// (census_transform.cpp, census_cost_kernels.hpp, semi_global_kernels.hpp):
+// SSE2 on x86-64, NEON on aarch64, a plain array everywhere, as
+// simd_i16.hpp does for 16-bit lanes. Integer lanes have one right answer,
+// so every backend gives the same bytes.
 #include <cstdint>
 
 #include "vision/simd_i16.hpp"
@@ -17,6 +18,7 @@ namespace rtfuse::vision::simd {
 
 // The definition the vector backends must agree with.
 struct PlainU8 {
+  static constexpr int kLanes = 16;
   struct V {
     std::uint8_t x[16];
   };
@@ -79,7 +81,7 @@ struct PlainU8 {
     r.x[15] = after.x[0];
     return r;
   }
-  // Lanes 0..7 and 8..15 as 16-bit lanes, zero-extended.
+  // The first and the last half of the lanes as 16-bit lanes, zero-extended.
   using Wide = PlainI16;
   static Wide::V widen_lo(V a) noexcept {
     Wide::V r;
@@ -109,6 +111,7 @@ struct PlainU8 {
 
 #if defined(__SSE2__)
 struct NativeU8 {
+  static constexpr int kLanes = 16;
   using V = __m128i;
   static V load(const std::uint8_t* p) noexcept { return _mm_loadu_si128(reinterpret_cast<const __m128i*>(p)); }
   static void store(std::uint8_t* p, V a) noexcept { _mm_storeu_si128(reinterpret_cast<__m128i*>(p), a); }
@@ -169,6 +172,7 @@ struct NativeU8 {
 };
 #elif defined(__ARM_NEON)
 struct NativeU8 {
+  static constexpr int kLanes = 16;
   using V = uint8x16_t;
   static V load(const std::uint8_t* p) noexcept { return vld1q_u8(p); }
   static void store(std::uint8_t* p, V a) noexcept { vst1q_u8(p, a); }

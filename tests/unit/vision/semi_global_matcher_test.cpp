@@ -2,8 +2,8 @@
 // known exactly: a textured plane shifted by an integer and by a fraction,
 // a slanted plane, a foreground square whose occlusion band the left-right
 // check must remove; the invalid border; bad input refused without a crash;
-// the same bytes twice and from every backend, a digest of 48
-// configurations that must not change; no allocation per frame.
+// the same bytes twice and from every backend (plain, the baseline's SSE2
+// or NEON), the same digest as before; no allocation per frame.
 #include "vision/semi_global_matcher.hpp"
 
 #include <gtest/gtest.h>
@@ -278,15 +278,17 @@ TEST(SemiGlobalMatcher, BadImagesReturnAStatus) {
 
 TEST(SemiGlobalMatcher, SameBytesTwiceAndNoAllocation) {
   const Pair p = occlusion_scene();
-  SemiGlobalMatcher m(kW, kH, params32());
-  Plane<std::uint16_t> a(kW, kH), b(kW, kH);
-  ASSERT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(a)), DisparityStatus::kOk);
-  {
-    test::AllocScope scope;
-    ASSERT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(b)), DisparityStatus::kOk);
-    EXPECT_EQ(scope.count(), 0u);
+  for (const DisparityBackend backend : {DisparityBackend::kAuto, DisparityBackend::kBaseline, DisparityBackend::kPlain}) {
+    SemiGlobalMatcher m(kW, kH, params32(), backend);
+    Plane<std::uint16_t> a(kW, kH), b(kW, kH);
+    ASSERT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(a)), DisparityStatus::kOk);
+    {
+      test::AllocScope scope;
+      ASSERT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(b)), DisparityStatus::kOk);
+      EXPECT_EQ(scope.count(), 0u) << to_string(m.backend());
+    }
+    for (int y = 0; y < kH; ++y) ASSERT_EQ(std::memcmp(a.row(y), b.row(y), kW * sizeof(std::uint16_t)), 0) << y;
   }
-  for (int y = 0; y < kH; ++y) ASSERT_EQ(std::memcmp(a.row(y), b.row(y), kW * sizeof(std::uint16_t)), 0) << y;
 }
 
 // The vector backends (SSE2 or NEON) against the plain definitions, on
@@ -358,7 +360,7 @@ TEST(SemiGlobalMatcher, VectorAndPlainBackendsAgree) {
 }
 
 // The selection fused into the matcher's last pass (packed_winner.hpp)
-// against the two-pass selection, with both backends: the same
+// against the two-pass selection, with every backend: the same
 // disparities, on random sums with many ties, with and without the cut of
 // the left columns, uniqueness and the left-right check.
 TEST(SemiGlobalMatcher, PackedSelectionMatchesTwoPassSelection) {
@@ -375,8 +377,8 @@ TEST(SemiGlobalMatcher, PackedSelectionMatchesTwoPassSelection) {
       for (const int uniqueness : {0, 10, 50}) {
         for (const int lr : {-1, 0, 1}) {
           select_disparity_row_portable(sums.data(), w, d, uniqueness, lr, scratch, expected.data());
-          select_disparity_row_packed<simd::NativeI16>(sums.data(), w, d, uniqueness, lr, scratch, native.data());
-          select_disparity_row_packed<simd::PlainI16>(sums.data(), w, d, uniqueness, lr, scratch, plain.data());
+          select_disparity_row_packed(sums.data(), w, d, uniqueness, lr, scratch, native.data());
+          select_disparity_row_packed_portable(sums.data(), w, d, uniqueness, lr, scratch, plain.data());
           ASSERT_EQ(native, expected) << d << " " << round << " " << uniqueness << " " << lr;
           ASSERT_EQ(plain, expected) << d << " " << round << " " << uniqueness << " " << lr;
         }
@@ -420,6 +422,9 @@ SizedPair digest_pair(int w, int h, int lo, int hi, std::uint32_t seed) {
 }
 
 constexpr int kDigestW = 333, kDigestH = 61;  // odd sizes: no row a multiple of a vector
+// The backends' comparisons run the plain lanes, several times slower (and
+// far slower under the sanitizers and emulation): a band of the height.
+constexpr int kCompareH = 25;
 
 struct DigestCase {
   DisparityParams params;
@@ -456,28 +461,63 @@ std::vector<DigestCase> digest_cases() {
   return cases;
 }
 
-// The disparities of one case, kDigestW x h.
-Plane<std::uint16_t> match_case(const DigestCase& c, int h) {
+// The disparities of one case on one backend, kDigestW x h.
+Plane<std::uint16_t> match_case(const DigestCase& c, int h, DisparityBackend backend, DisparityBackend* used) {
   const SizedPair p = digest_pair(kDigestW, h, c.params.disparities / 8, c.params.disparities / 2, c.seed);
-  SemiGlobalMatcher m(kDigestW, h, c.params);
+  SemiGlobalMatcher m(kDigestW, h, c.params, backend);
   EXPECT_TRUE(m.valid()) << m.error();
   Plane<std::uint16_t> out(m.output_width(kDigestW), m.output_height(h));
   EXPECT_EQ(m.compute(view_of(p.left), view_of(p.right), view_of(out)), DisparityStatus::kOk);
+  *used = m.backend();
   return out;
 }
 
+bool same_bytes(const Plane<std::uint16_t>& a, const Plane<std::uint16_t>& b) {
+  for (int y = 0; y < a.height(); ++y) {
+    if (std::memcmp(a.row(y), b.row(y), static_cast<std::size_t>(a.width()) * sizeof(std::uint16_t)) != 0) return false;
+  }
+  return true;
+}
+
 // The digest of every configuration's disparities: the same from the SSE2,
-// plain and NEON builds, and to stay so whatever the loops become.
+// plain and NEON builds, and to stay so whatever the loops become (on the
+// fastest backend this machine runs).
 TEST(SemiGlobalMatcher, DigestOfConfigurationsUnchanged) {
   Xxh64 all;
   for (const DigestCase& c : digest_cases()) {
-    const Plane<std::uint16_t> out = match_case(c, kDigestH);
+    DisparityBackend used = DisparityBackend::kAuto;
+    const Plane<std::uint16_t> out = match_case(c, kDigestH, DisparityBackend::kAuto, &used);
     Xxh64 one;
     for (int y = 0; y < out.height(); ++y) one.update(out.row(y), static_cast<std::size_t>(out.width()) * 2);
     const std::uint64_t digest = one.digest();
     all.update(&digest, sizeof digest);  // little-endian on both architectures
   }
   EXPECT_EQ(all.digest(), 0x2a6a144db57688ecULL);
+}
+
+// The build's baseline lanes (SSE2, NEON) against the plain ones, through
+// the whole matcher, on every configuration of the digest.
+TEST(SemiGlobalMatcher, BaselineMatcherGivesThePlainBytes) {
+  int i = 0;
+  for (const DigestCase& c : digest_cases()) {
+    DisparityBackend used_plain = DisparityBackend::kAuto, used = DisparityBackend::kAuto;
+    const Plane<std::uint16_t> plain = match_case(c, kCompareH, DisparityBackend::kPlain, &used_plain);
+    const Plane<std::uint16_t> baseline = match_case(c, kCompareH, DisparityBackend::kBaseline, &used);
+    ASSERT_EQ(used_plain, DisparityBackend::kPlain);
+    ASSERT_EQ(used, DisparityBackend::kBaseline);
+    EXPECT_TRUE(same_bytes(baseline, plain)) << "case " << i;
+    ++i;
+  }
+}
+
+TEST(SemiGlobalMatcher, BackendChosenAtConstruction) {
+  DisparityParams p;  // 64 disparities
+  EXPECT_EQ(SemiGlobalMatcher(640, 480, p, DisparityBackend::kPlain).backend(), DisparityBackend::kPlain);
+  EXPECT_EQ(SemiGlobalMatcher(640, 480, p, DisparityBackend::kBaseline).backend(), DisparityBackend::kBaseline);
+  EXPECT_EQ(SemiGlobalMatcher(640, 480, p).backend(), DisparityBackend::kBaseline);
+  for (const auto b : {DisparityBackend::kAuto, DisparityBackend::kBaseline, DisparityBackend::kPlain}) {
+    EXPECT_STRNE(to_string(b), "unknown");
+  }
 }
 
 // Sums too wide to pack with their disparity (a larger P2 and range) take
