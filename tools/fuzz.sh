@@ -73,11 +73,12 @@ fi
 { printf '# Octomap OcTree binary file\nid OcTree\nsize 11\nres 0.1\ndata\n\x00\xc0'
   for _ in $(seq 8); do printf '\x03\x00'; done; printf '\x01\x00'; } >"$seeds/octomap_binary/coarse.bt"
 printf '# a comment, a blank line, signs and exponents\n\n+1.5 -2e-1 0.25\n 3 4 5 \n' >"$seeds/point_cloud/small.xyz"
-# map_server maps: a YAML as the mapper writes it (first byte odd), a
-# binary and a plain PGM (first byte even).
+# rtfuse-plan's inputs: a YAML as the mapper writes it (first byte 1), a
+# binary and a plain PGM (0), start/goal pairs (2).
 printf '\x01image: map.pgm\nmode: trinary\nresolution: 0.05\norigin: [-10, -10, 0.0]\nnegate: 0\noccupied_thresh: 0.65\nfree_thresh: 0.196\n' >"$seeds/map_server/map.yaml"
 printf '\x00P5\n3 2\n255\n\x00\xfe\xcd\xcd\xfe\x00' >"$seeds/map_server/binary.pgm"
 printf '\x00P2\n# comment\n2 2\n255\n0 254\n205 100\n' >"$seeds/map_server/plain.pgm"
+printf '\x02# sx sy gx gy\n10 10 300 250\n\n+3 4 5 -6\n' >"$seeds/map_server/pairs.txt"
 "$dir/tests/fuzz/make_seeds" "$seeds" >/dev/null
 for h in "${all[@]}"; do
   [[ -d "$root/tests/fuzz/regressions/$h" ]] && cp "$root/tests/fuzz/regressions/$h"/* "$seeds/$h/"

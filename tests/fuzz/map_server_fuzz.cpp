@@ -1,25 +1,41 @@
-// rtfuse-plan's maps: the map_server YAML and the PGM it names
-// (apps/map_server_map.hpp). The first byte picks the parser.
+// rtfuse-plan's inputs: the map_server YAML and the PGM it names
+// (apps/map_server_map.hpp), and the start/goal pairs (apps/plan_pairs.hpp).
+// The first byte picks the parser (0 PGM, 1 YAML, 2 pairs, modulo 3).
 // Property: refused with a reason naming the file, or a result that holds
 // together: a YAML's resolution positive and finite, its thresholds in
 // order; a PGM's pixels as many as its size says, none above its maximum;
 // the cells made of them within nav_msgs/OccupancyGrid's -1..100 in every
-// mode.
+// mode; a pair for each row, its line within the file.
 #include <cmath>
 #include <cstddef>
 #include <cstdint>
 #include <string>
 
+#include <stdexcept>
+
 #include "apps/map_server_map.hpp"
+#include "apps/plan_pairs.hpp"
 #include "fuzz_check.hpp"
 
 extern "C" int LLVMFuzzerTestOneInput(const std::uint8_t* data, std::size_t size) {
   using namespace rtfuse::apps;
   if (size == 0) return 0;
-  const bool yaml_input = (data[0] & 1) != 0;
+  const int which = data[0] % 3;
   ++data;
   --size;
-  if (yaml_input) {
+  if (which == 2) {
+    std::size_t lines = 1;
+    for (std::size_t i = 0; i < size; ++i) lines += data[i] == '\n';
+    try {
+      for (const PlanPair& p : parse_plan_pairs(std::string_view(reinterpret_cast<const char*>(data), size), "pairs.txt")) {
+        FUZZ_CHECK(p.line >= 1 && p.line <= lines, "a pair's line is in the file");
+      }
+    } catch (const std::runtime_error& e) {
+      FUZZ_CHECK(std::string(e.what()).rfind("pairs.txt:", 0) == 0, "the error names the file and line");
+    }
+    return 0;
+  }
+  if (which == 1) {
     MapServerYaml yaml;
     const std::string error = parse_map_yaml(std::string(reinterpret_cast<const char*>(data), size), "map.yaml", &yaml);
     if (!error.empty()) {

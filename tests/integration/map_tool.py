@@ -148,7 +148,7 @@ def check_bad(tmp):
     expect(run("--cloud", bad, "--out", out), 1, bad + ":3:", '"x" is not a number')
     with open(bad, "w") as f:
         f.write("1 2 3\n4 5\n")
-    expect(run("--cloud", bad, "--out", out), 1, bad + ":2:", "three numbers")
+    expect(run("--cloud", bad, "--out", out), 1, bad + ":2:", "expected 3 numbers")
     with open(bad, "w") as f:
         f.write("1 2 nan\n")
     expect(run("--cloud", bad, "--out", out), 1, bad + ":1:", "not finite")
