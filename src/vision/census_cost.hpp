@@ -25,4 +25,10 @@ void census_cost_row(const std::uint8_t* const* left, const std::uint8_t* const*
 void census_cost_row_portable(const std::uint8_t* const* left, const std::uint8_t* const* right_reversed, int width,
                               int disparities, std::uint8_t* cost) noexcept;
 
+// The same with AVX2's 32 lanes (simd_avx2.hpp), where this CPU has AVX2
+// and disparities is a multiple of 32; false, and nothing written,
+// otherwise (and on every other architecture).
+bool census_cost_row_avx2(const std::uint8_t* const* left, const std::uint8_t* const* right_reversed, int width,
+                          int disparities, std::uint8_t* cost) noexcept;
+
 }  // namespace rtfuse::vision

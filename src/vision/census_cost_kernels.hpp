@@ -1,8 +1,10 @@
 // The census cost loop (census_cost.hpp), written once over a lane
-// backend B (simd_u8.hpp) so that it can be compiled once per
+// backend B (simd_u8.hpp, simd_avx2.hpp) and compiled once per
 // instruction set: deliberately no include guard and no includes. The
 // includer puts it inside a namespace of its own per instruction set,
-// after including <cstdint> and vision/census_cost.hpp.
+// the AVX2 one between RTFUSE_AVX2_BEGIN and RTFUSE_AVX2_END
+// (simd_avx2.hpp says why), after including <cstdint> and
+// vision/census_cost.hpp.
 
 static_assert(kCensusPlanes == 4, "the cost loop counts four planes at once");
 

@@ -15,10 +15,10 @@
 // otherwise.
 //
 // Uniqueness needs the least sum more than one step from the winner. Lane
-// i holds the disparities i mod the lane count (8), and three neighbouring
-// disparities fall in three different lanes, so per lane the least and
-// second least packed values are enough: the second stands in where the
-// least is the window's.
+// i holds the disparities i mod the lane count (8, or AVX2's 16), and three
+// neighbouring disparities fall in three different lanes, so per lane the
+// least and second least packed values are enough: the second stands in
+// where the least is the window's.
 //
 // The right view keeps, per right column, the least packed value over the
 // left pixels that match it (its winner and tie rule as in
@@ -45,11 +45,15 @@ inline bool packed_winner_fits(int max_sum, int disparities) noexcept {
 
 // A whole row through PackedWinner, in the matcher's order (right to
 // left), with select_disparity_row's arguments: on the build's baseline
-// lanes (SSE2, NEON) and on plain lanes. The tests hold them against
-// select_disparity_row.
+// lanes (SSE2, NEON), on plain lanes, and on AVX2's (false, and nothing
+// written, where this CPU has no AVX2 or disparities is not a multiple of
+// 16). The tests hold them against select_disparity_row.
 void select_disparity_row_packed(const std::int16_t* sums, int width, int disparities, int uniqueness_percent,
                                  int lr_max_diff, const DisparityRowScratch& scratch, std::int16_t* out) noexcept;
 void select_disparity_row_packed_portable(const std::int16_t* sums, int width, int disparities,
                                           int uniqueness_percent, int lr_max_diff, const DisparityRowScratch& scratch,
                                           std::int16_t* out) noexcept;
+bool select_disparity_row_packed_avx2(const std::int16_t* sums, int width, int disparities, int uniqueness_percent,
+                                      int lr_max_diff, const DisparityRowScratch& scratch, std::int16_t* out) noexcept;
+
 }  // namespace rtfuse::vision

@@ -1,12 +1,14 @@
 // The dense matcher's vector loops (semi_global_matcher.hpp): the fused
 // selection, the path costs and the two passes over the image, written
-// once over a lane backend (simd_u8.hpp) and its lane count, so that they
-// can be compiled once per instruction set. Deliberately no include guard
+// once over a lane backend (simd_u8.hpp's 16 lanes, simd_avx2.hpp's 32)
+// and compiled once per instruction set. Deliberately no include guard
 // and no includes: semi_global_matcher.cpp puts it inside a namespace of
-// its own per instruction set, after census_cost_kernels.hpp in the same
-// namespace and after defining kPathBeyondRange and kSlotFirst (the path
-// rows' layout). Every backend computes the same integers: the lane count
-// changes how many disparities a step takes, never a value.
+// its own per instruction set, the AVX2 one between RTFUSE_AVX2_BEGIN and
+// RTFUSE_AVX2_END (simd_avx2.hpp says why), after census_cost_kernels.hpp
+// in the same namespace and after defining kPathBeyondRange and
+// kSlotFirst (the path rows' layout). Every backend computes the same
+// integers: the lane count changes how many disparities a step takes,
+// never a value.
 
 // The selection of packed_winner.hpp for one row, pixel by pixel as the
 // upward pass finishes each pixel's sums. L: 16-bit lanes.
@@ -124,7 +126,7 @@ inline void select_row_packed(const std::int16_t* sums, int width, int dispariti
 // the pixel's matching costs, B::kLanes disparities a step; the two paths'
 // sum (bytes) goes to sink(k, sum of k .. k + B::kLanes - 1). Two paths a
 // sweep (a pass's four take two sweeps): with more, their vectors no
-// longer fit the sixteen registers of SSE2 and spill.
+// longer fit the sixteen registers of SSE2 or AVX2 and spill.
 template <class B, bool kRowPath, class Sink>
 inline void update_path_pair(const std::uint8_t* const* prev, std::uint8_t* const* cur, const std::uint8_t* cost,
                              int disparities, typename B::V p1, typename B::V jump, Sink&& sink) noexcept {

@@ -5,6 +5,7 @@
 #include <cstdint>
 #include <cstdlib>
 #include <cstring>
+#include <new>
 #include <utility>
 
 #include "vision/census_cost.hpp"
@@ -13,6 +14,7 @@
 #include "vision/disparity_selection.hpp"
 #include "vision/feature_filters.hpp"
 #include "vision/packed_winner.hpp"
+#include "vision/simd_avx2.hpp"
 #include "vision/simd_u8.hpp"
 
 namespace rtfuse::vision {
@@ -25,24 +27,63 @@ namespace {
 // the disparity range" (a step there never wins; adding P1 saturates).
 constexpr std::uint8_t kPathBeyondRange = 0xff;
 constexpr int kMaxP2 = 127 - kCensusBits;
-// Each path row slot: [0] the slot's least cost, [15] and [16 + D] the
-// beyond-range values, [16, 16 + D) the costs.
-constexpr int kSlotPad = 32;
-constexpr int kSlotFirst = 16;
+// Each path row slot: [0] the slot's least cost, [31] and [32 + D] the
+// beyond-range values, [32, 32 + D) the costs, aligned for 32-byte
+// vectors; the row path's 32-lane load past the range reads up to
+// [63 + D].
+constexpr int kSlotPad = 64;
+constexpr int kSlotFirst = 32;
 // A cost volume larger than this is refused rather than allocated (3 GB of
 // costs and sums).
 constexpr long long kMaxCells = 1LL << 30;
+// The workspace's arrays start on a cache line: with d a multiple of the
+// lane count, the volumes' and path rows' vectors then never straddle one
+// (32-byte vectors from malloc's 16-byte alignment would, every other).
+constexpr std::size_t kAlign = 64;
 
-// The matcher's loops, compiled for the build's baseline (SSE2, NEON, or
-// plain where neither; both NativeU8 and PlainU8 instantiate them).
+// The matcher's loops, compiled once for the build's baseline (SSE2,
+// NEON, or plain where neither; both NativeU8 and PlainU8 instantiate
+// them) and once for AVX2 (simd_avx2.hpp), from the same source.
 namespace lanes {
 #include "vision/census_cost_kernels.hpp"
 #include "vision/semi_global_kernels.hpp"
 }  // namespace lanes
+#if RTFUSE_SIMD_AVX2
+RTFUSE_AVX2_BEGIN
+namespace avx2 {
+#include "vision/census_cost_kernels.hpp"
+#include "vision/semi_global_kernels.hpp"
+}  // namespace avx2
+RTFUSE_AVX2_END
+#endif
 
-// The backend a matcher runs on.
-DisparityBackend resolve_backend(DisparityBackend requested) noexcept {
-  return requested == DisparityBackend::kPlain ? DisparityBackend::kPlain : DisparityBackend::kBaseline;
+template <class T>
+struct AlignedDelete {
+  void operator()(T* p) const noexcept { ::operator delete[](p, std::align_val_t{kAlign}); }
+};
+template <class T>
+using AlignedArray = std::unique_ptr<T[], AlignedDelete<T>>;
+
+// n values of T on a cache line, zeroed if asked (the volumes are not:
+// their pages are touched when first written).
+template <class T>
+AlignedArray<T> aligned_array(std::size_t n, bool zeroed = true) {
+  T* p = static_cast<T*>(::operator new[](n * sizeof(T), std::align_val_t{kAlign}));
+  if (zeroed) std::memset(p, 0, n * sizeof(T));
+  return AlignedArray<T>(p);
+}
+
+// The backend a matcher with d matched disparities runs on.
+DisparityBackend resolve_backend(DisparityBackend requested, int d) noexcept {
+  if (requested == DisparityBackend::kPlain) return DisparityBackend::kPlain;
+#if RTFUSE_SIMD_AVX2
+  if (requested != DisparityBackend::kBaseline && d % simd::Avx2U8::kLanes == 0 && simd::cpu_has_avx2()) {
+    return DisparityBackend::kAvx2;
+  }
+#else
+  (void)d;
+#endif
+  return DisparityBackend::kBaseline;
 }
 
 }  // namespace
@@ -71,6 +112,8 @@ const char* to_string(DisparityBackend b) noexcept {
       return "auto";
     case DisparityBackend::kBaseline:
       return "baseline";
+    case DisparityBackend::kAvx2:
+      return "avx2";
     case DisparityBackend::kPlain:
       return "plain";
   }
@@ -80,18 +123,22 @@ const char* to_string(DisparityBackend b) noexcept {
 struct SemiGlobalMatcher::Workspace {
   Workspace(int w, int h, int d, bool halve)
       : slot(d + kSlotPad),
-        cost(new std::uint8_t[static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(d) +
-                              kSlotPad]),
-        sums(new std::int16_t[static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(d)]),
+        cost(aligned_array<std::uint8_t>(static_cast<std::size_t>(w) * static_cast<std::size_t>(h) *
+                                             static_cast<std::size_t>(d) +
+                                             kSlotPad,
+                                         false)),
+        sums(aligned_array<std::int16_t>(
+            static_cast<std::size_t>(w) * static_cast<std::size_t>(h) * static_cast<std::size_t>(d), false)),
         reversed_stride(w + d + 32),
-        right_reversed(new std::uint8_t[static_cast<std::size_t>(kCensusPlanes) * static_cast<std::size_t>(reversed_stride)]()),
-        path_rows(new std::uint8_t[static_cast<std::size_t>(6 * w + 3) * static_cast<std::size_t>(slot)]),
+        right_reversed(
+            aligned_array<std::uint8_t>(static_cast<std::size_t>(kCensusPlanes) * static_cast<std::size_t>(reversed_stride))),
+        path_rows(aligned_array<std::uint8_t>(static_cast<std::size_t>(6 * w + 3) * static_cast<std::size_t>(slot), false)),
         disparity(w, h),
-        left_best(new std::int16_t[static_cast<std::size_t>(w)]()),
-        right_best(new std::int16_t[static_cast<std::size_t>(w + d)]()),
-        right_cost(new std::int16_t[static_cast<std::size_t>(w + d)]()),
-        total(new std::int16_t[static_cast<std::size_t>(d)]()),
-        row_sums(new std::int16_t[static_cast<std::size_t>(w) * static_cast<std::size_t>(d)]()),
+        left_best(aligned_array<std::int16_t>(static_cast<std::size_t>(w))),
+        right_best(aligned_array<std::int16_t>(static_cast<std::size_t>(w + d))),
+        right_cost(aligned_array<std::int16_t>(static_cast<std::size_t>(w + d))),
+        total(aligned_array<std::int16_t>(static_cast<std::size_t>(d))),
+        row_sums(aligned_array<std::int16_t>(static_cast<std::size_t>(w) * static_cast<std::size_t>(d))),
         speckles(w * h) {
     if (halve) {
       half_left = Plane<std::uint8_t>(w, h);
@@ -117,21 +164,21 @@ struct SemiGlobalMatcher::Workspace {
   }
 
   int slot;
-  std::unique_ptr<std::uint8_t[]> cost;   // [y][x][d]
-  std::unique_ptr<std::int16_t[]> sums;   // [y][x][d]
+  AlignedArray<std::uint8_t> cost;  // [y][x][d]
+  AlignedArray<std::int16_t> sums;  // [y][x][d]
   int reversed_stride;
-  std::unique_ptr<std::uint8_t[]> right_reversed;  // per census plane, one row reversed
-  std::unique_ptr<std::uint8_t[]> path_rows;
+  AlignedArray<std::uint8_t> right_reversed;  // per census plane, one row reversed
+  AlignedArray<std::uint8_t> path_rows;
   std::uint8_t* rows[6] = {};        // three directions' previous and current rows
   std::uint8_t* horizontal[2] = {};  // the row path's previous and current pixel
   std::uint8_t* zero = nullptr;      // where a path enters the image
   Plane<std::uint8_t> half_left, half_right;
   Plane<std::uint8_t> census_left[kCensusPlanes], census_right[kCensusPlanes];
   Plane<std::int16_t> disparity;  // matched pixels * kDisparityScale, -1 invalid
-  std::unique_ptr<std::int16_t[]> left_best, right_best;
-  std::unique_ptr<std::int16_t[]> right_cost;
-  std::unique_ptr<std::int16_t[]> total;     // one pixel's complete sums (fused selection)
-  std::unique_ptr<std::int16_t[]> row_sums;  // one row's (two-pass selection)
+  AlignedArray<std::int16_t> left_best, right_best;
+  AlignedArray<std::int16_t> right_cost;
+  AlignedArray<std::int16_t> total;     // one pixel's complete sums (fused selection)
+  AlignedArray<std::int16_t> row_sums;  // one row's (two-pass selection)
   SpeckleFilter speckles;
 };
 
@@ -166,7 +213,7 @@ SemiGlobalMatcher::SemiGlobalMatcher(int max_width, int max_height, const Dispar
     return;
   }
   ws_ = std::make_unique<Workspace>(max_width_, max_height_, disparities_, p.downscale == 2);
-  backend_ = resolve_backend(backend);
+  backend_ = resolve_backend(backend, disparities_);
 }
 
 SemiGlobalMatcher::~SemiGlobalMatcher() = default;
@@ -198,7 +245,8 @@ void SemiGlobalMatcher::match(const GreyView& left_in, const GreyView& right_in,
   }
   // Sums are at most paths * (P2 + the largest cost): see kMaxP2.
   const bool fused = packed_winner_fits(params_.paths * (params_.p2 + kCensusBits), d);
-  // The plain backend is plain throughout.
+  // The census itself (a twentieth of the time) stays on the baseline's
+  // lanes with AVX2; the plain backend is plain throughout.
   if (backend_ == DisparityBackend::kPlain) {
     census_transform_9x7_portable(left, ws.census_left);
     census_transform_9x7_portable(right, ws.census_right);
@@ -210,6 +258,11 @@ void SemiGlobalMatcher::match(const GreyView& left_in, const GreyView& right_in,
     case DisparityBackend::kPlain:
       lanes::aggregate_image<simd::PlainU8>(ws, params_, w, h, d, fused);
       break;
+#if RTFUSE_SIMD_AVX2
+    case DisparityBackend::kAvx2:  // only where cpu_has_avx2() (resolve_backend)
+      avx2::aggregate_image<simd::Avx2U8>(ws, params_, w, h, d, fused);
+      break;
+#endif
     default:
       lanes::aggregate_image<simd::NativeU8>(ws, params_, w, h, d, fused);
       break;
@@ -251,6 +304,18 @@ void select_disparity_row_packed_portable(const std::int16_t* sums, int width, i
                                           int uniqueness_percent, int lr_max_diff, const DisparityRowScratch& scratch,
                                           std::int16_t* out) noexcept {
   lanes::select_row_packed<simd::PlainI16>(sums, width, disparities, uniqueness_percent, lr_max_diff, scratch, out);
+}
+
+bool select_disparity_row_packed_avx2(const std::int16_t* sums, int width, int disparities, int uniqueness_percent,
+                                      int lr_max_diff, const DisparityRowScratch& scratch, std::int16_t* out) noexcept {
+#if RTFUSE_SIMD_AVX2
+  if (!simd::cpu_has_avx2() || disparities % simd::Avx2I16::kLanes != 0) return false;
+  avx2::select_row_packed<simd::Avx2I16>(sums, width, disparities, uniqueness_percent, lr_max_diff, scratch, out);
+  return true;
+#else
+  (void)sums, (void)width, (void)disparities, (void)uniqueness_percent, (void)lr_max_diff, (void)scratch, (void)out;
+  return false;
+#endif
 }
 
 }  // namespace rtfuse::vision

@@ -11,8 +11,9 @@
 //      One pass down the image runs the paths that come from the left and
 //      from above, one pass up the others; the sums of the first wait in a
 //      16-bit volume. Path costs fit a byte (P2 <= 96), so sixteen
-//      disparities go in a vector (simd_u8.hpp: SSE2, NEON or plain, the
-//      same integers);
+//      disparities go in a vector (simd_u8.hpp: SSE2, NEON or plain), or
+//      thirty-two with AVX2 where the CPU has it (simd_avx2.hpp, chosen
+//      at construction), the same integers;
 //   4. per pixel, as the upward pass finishes its sums: winner-take-all,
 //      uniqueness, parabola fraction, and per row the left-right check
 //      (packed_winner.hpp; disparity_selection.hpp where the sums are too
@@ -48,8 +49,10 @@ const char* to_string(DisparityStatus s) noexcept;
 // The instructions the matcher's loops run on. Integer lanes have one
 // right answer, so every backend gives the same disparities, bit for bit.
 enum class DisparityBackend : std::uint8_t {
-  kAuto,      // the fastest this CPU runs: kBaseline
+  kAuto,      // kAvx2 where it applies, else kBaseline
   kBaseline,  // the build's baseline vectors: SSE2 on x86-64, NEON on aarch64 (plain lanes if neither)
+  kAvx2,      // 32-byte lanes, for x86-64 CPUs with AVX2 and matched disparities a multiple of 32;
+              // elsewhere kBaseline is used
   kPlain,     // plain C++ lanes, the definition the others are tested against
 };
 

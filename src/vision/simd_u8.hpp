@@ -2,8 +2,9 @@
 // Sixteen unsigned 8-bit lanes for the census and aggregation loops
 // (census_transform.cpp, census_cost_kernels.hpp, semi_global_kernels.hpp):
 // SSE2 on x86-64, NEON on aarch64, a plain array everywhere, as
-// simd_i16.hpp does for 16-bit lanes. Integer lanes have one right answer,
-// so every backend gives the same bytes.
+// simd_i16.hpp does for 16-bit lanes (simd_avx2.hpp: AVX2's 32, chosen at
+// run time). Integer lanes have one right answer, so every backend gives
+// the same bytes.
 #include <cstdint>
 
 #include "vision/simd_i16.hpp"

@@ -3,7 +3,8 @@
 // a slanted plane, a foreground square whose occlusion band the left-right
 // check must remove; the invalid border; bad input refused without a crash;
 // the same bytes twice and from every backend (plain, the baseline's SSE2
-// or NEON), the same digest as before; no allocation per frame.
+// or NEON, AVX2 where the CPU has it), the same digest as before; no
+// allocation per frame.
 #include "vision/semi_global_matcher.hpp"
 
 #include <gtest/gtest.h>
@@ -22,6 +23,7 @@
 #include "vision/census_transform.hpp"
 #include "vision/disparity_selection.hpp"
 #include "vision/packed_winner.hpp"
+#include "vision/simd_avx2.hpp"
 #include "vision/simd_u8.hpp"
 
 namespace rtfuse::vision {
@@ -368,7 +370,7 @@ TEST(SemiGlobalMatcher, PackedSelectionMatchesTwoPassSelection) {
   for (const int d : {16, 32, 64}) {
     const int w = 150;
     std::vector<std::int16_t> sums(static_cast<std::size_t>(w) * d);
-    std::vector<std::int16_t> lb(w), rb(w + d), rc(w + d), expected(w), native(w), plain(w);
+    std::vector<std::int16_t> lb(w), rb(w + d), rc(w + d), expected(w), native(w), plain(w), avx2(w);
     const DisparityRowScratch scratch{lb.data(), rb.data(), rc.data()};
     for (int round = 0; round < 20; ++round) {
       const int range = round % 2 == 0 ? 8 : 728;  // ties, or the default's largest sums
@@ -381,11 +383,90 @@ TEST(SemiGlobalMatcher, PackedSelectionMatchesTwoPassSelection) {
           select_disparity_row_packed_portable(sums.data(), w, d, uniqueness, lr, scratch, plain.data());
           ASSERT_EQ(native, expected) << d << " " << round << " " << uniqueness << " " << lr;
           ASSERT_EQ(plain, expected) << d << " " << round << " " << uniqueness << " " << lr;
+          // Sixteen lanes of AVX2 where the CPU has it (else nothing to
+          // compare: Avx2BackendAgreesWithPlain says so by skipping).
+          if (select_disparity_row_packed_avx2(sums.data(), w, d, uniqueness, lr, scratch, avx2.data())) {
+            ASSERT_EQ(avx2, expected) << d << " " << round << " " << uniqueness << " " << lr;
+          }
         }
       }
     }
   }
   EXPECT_FALSE(packed_winner_fits(728, 128));  // the matcher selects in two passes then
+}
+
+#if RTFUSE_SIMD_AVX2
+RTFUSE_AVX2_BEGIN
+// Avx2U8's four-plane count of a[0] ^ a[1], ..., a[6] ^ a[7] into out;
+// compiled for AVX2, so called only where the CPU has it.
+void avx2_xor_popcount4(const std::uint8_t (*a)[32], std::uint8_t* out) {
+  using A = simd::Avx2U8;
+  A::store(out, A::xor_popcount4(A::load(a[0]), A::load(a[1]), A::load(a[2]), A::load(a[3]), A::load(a[4]),
+                                 A::load(a[5]), A::load(a[6]), A::load(a[7])));
+}
+RTFUSE_AVX2_END
+#endif
+
+bool cpu_runs_avx2() {
+#if RTFUSE_SIMD_AVX2
+  return simd::cpu_has_avx2();
+#else
+  return false;
+#endif
+}
+
+// AVX2's 32 lanes (simd_avx2.hpp) against the plain definitions: the
+// four-plane bit count (every bit different, and random bytes) and cost
+// rows at several ranges, on random census planes. (Its selection:
+// PackedSelectionMatchesTwoPassSelection; the whole matcher:
+// Avx2MatcherGivesThePlainBytes.)
+TEST(SemiGlobalMatcher, Avx2BackendAgreesWithPlain) {
+  if (!cpu_runs_avx2()) GTEST_SKIP() << "no AVX2 on this CPU or architecture: nothing runs it";
+#if RTFUSE_SIMD_AVX2
+  std::mt19937 rng(29);
+  std::uint8_t a[8][32];
+  for (int round = 0; round < 64; ++round) {
+    for (int k = 0; k < 8; ++k) {
+      for (int i = 0; i < 32; ++i) {
+        const auto r = static_cast<std::uint8_t>(rng());
+        a[k][i] = round % 2 == 0 ? static_cast<std::uint8_t>((r & 1) != 0 ? 0xff : 0) : r;
+        if (k >= 6) a[k][i] &= 0x7f;  // the last plane's 7 bits
+      }
+    }
+    std::uint8_t avx2_count[32];
+    avx2_xor_popcount4(a, avx2_count);
+    using P = simd::PlainU8;
+    for (int half = 0; half < 2; ++half) {
+      const int o = 16 * half;
+      const P::V plain_count = P::xor_popcount4(P::load(a[0] + o), P::load(a[1] + o), P::load(a[2] + o),
+                                                P::load(a[3] + o), P::load(a[4] + o), P::load(a[5] + o),
+                                                P::load(a[6] + o), P::load(a[7] + o));
+      ASSERT_EQ(std::memcmp(avx2_count + o, plain_count.x, 16), 0) << round << " " << half;
+    }
+  }
+  for (const int d : {32, 64, 96, 128}) {
+    const int w = d + 45, stride = w + d + 32;
+    std::vector<std::uint8_t> left(static_cast<std::size_t>(kCensusPlanes) * w);
+    std::vector<std::uint8_t> reversed(static_cast<std::size_t>(kCensusPlanes) * stride);
+    for (auto* v : {&left, &reversed}) {
+      for (std::size_t i = 0; i < v->size(); ++i) {
+        (*v)[i] = static_cast<std::uint8_t>(rng() & (i % 4 == 3 ? 0x7f : 0xff));
+      }
+    }
+    const std::uint8_t *lp[kCensusPlanes], *rp[kCensusPlanes];
+    for (int g = 0; g < kCensusPlanes; ++g) {
+      lp[g] = left.data() + static_cast<std::size_t>(g) * w;
+      rp[g] = reversed.data() + static_cast<std::size_t>(g) * stride;
+    }
+    std::vector<std::uint8_t> cost_avx2(static_cast<std::size_t>(w) * d + 16), cost_plain(cost_avx2.size());
+    ASSERT_TRUE(census_cost_row_avx2(lp, rp, w, d, cost_avx2.data()));
+    census_cost_row_portable(lp, rp, w, d, cost_plain.data());
+    ASSERT_EQ(std::memcmp(cost_avx2.data(), cost_plain.data(), static_cast<std::size_t>(w) * d), 0) << d;
+  }
+  std::uint8_t unused[48 * 16] = {};
+  const std::uint8_t* planes[kCensusPlanes] = {unused, unused, unused, unused};
+  EXPECT_FALSE(census_cost_row_avx2(planes, planes, 16, 48, unused));  // not a multiple of 32
+#endif
 }
 
 // The digest's pairs: a texture of grey levels on a 3 px lattice, bilinear
@@ -479,9 +560,9 @@ bool same_bytes(const Plane<std::uint16_t>& a, const Plane<std::uint16_t>& b) {
   return true;
 }
 
-// The digest of every configuration's disparities: the same from the SSE2,
-// plain and NEON builds, and to stay so whatever the loops become (on the
-// fastest backend this machine runs).
+// The digest of every configuration's disparities is the one the matcher
+// gave before the AVX2 backend (SSE2, plain and NEON builds alike): on
+// this machine's fastest backend, so on x86-64 with AVX2 it checks AVX2.
 TEST(SemiGlobalMatcher, DigestOfConfigurationsUnchanged) {
   Xxh64 all;
   for (const DigestCase& c : digest_cases()) {
@@ -510,12 +591,39 @@ TEST(SemiGlobalMatcher, BaselineMatcherGivesThePlainBytes) {
   }
 }
 
+// AVX2 against the plain lanes through the whole matcher, on every
+// configuration of the digest whose matched disparities are a multiple
+// of 32 (the others run the baseline, as asked of kAvx2 there).
+TEST(SemiGlobalMatcher, Avx2MatcherGivesThePlainBytes) {
+  if (!cpu_runs_avx2()) GTEST_SKIP() << "no AVX2 on this CPU or architecture: nothing runs it";
+  int i = 0, on_avx2 = 0;
+  for (const DigestCase& c : digest_cases()) {
+    DisparityBackend used_plain = DisparityBackend::kAuto, used = DisparityBackend::kAuto;
+    const Plane<std::uint16_t> plain = match_case(c, kCompareH, DisparityBackend::kPlain, &used_plain);
+    const Plane<std::uint16_t> avx2 = match_case(c, kCompareH, DisparityBackend::kAvx2, &used);
+    const bool applies = (c.params.disparities / c.params.downscale) % 32 == 0;
+    ASSERT_EQ(used, applies ? DisparityBackend::kAvx2 : DisparityBackend::kBaseline) << "case " << i;
+    EXPECT_TRUE(same_bytes(avx2, plain)) << "case " << i;
+    on_avx2 += applies ? 1 : 0;
+    ++i;
+  }
+  EXPECT_EQ(on_avx2, 32);
+}
+
 TEST(SemiGlobalMatcher, BackendChosenAtConstruction) {
   DisparityParams p;  // 64 disparities
   EXPECT_EQ(SemiGlobalMatcher(640, 480, p, DisparityBackend::kPlain).backend(), DisparityBackend::kPlain);
   EXPECT_EQ(SemiGlobalMatcher(640, 480, p, DisparityBackend::kBaseline).backend(), DisparityBackend::kBaseline);
+  const DisparityBackend fastest = cpu_runs_avx2() ? DisparityBackend::kAvx2 : DisparityBackend::kBaseline;
+  EXPECT_EQ(SemiGlobalMatcher(640, 480, p).backend(), fastest);
+  EXPECT_EQ(SemiGlobalMatcher(640, 480, p, DisparityBackend::kAvx2).backend(), fastest);
+  p.disparities = 48;  // not a multiple of 32: the baseline
   EXPECT_EQ(SemiGlobalMatcher(640, 480, p).backend(), DisparityBackend::kBaseline);
-  for (const auto b : {DisparityBackend::kAuto, DisparityBackend::kBaseline, DisparityBackend::kPlain}) {
+  p.disparities = 64;
+  p.downscale = 2;  // 32 matched
+  EXPECT_EQ(SemiGlobalMatcher(640, 480, p).backend(), fastest);
+  for (const auto b : {DisparityBackend::kAuto, DisparityBackend::kBaseline, DisparityBackend::kAvx2,
+                       DisparityBackend::kPlain}) {
     EXPECT_STRNE(to_string(b), "unknown");
   }
 }
