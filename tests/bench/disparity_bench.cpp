@@ -7,7 +7,10 @@
 //                          plane (disparities N/8 to N/2), rendered here so
 //                          the benchmark needs no files.
 //   BM_Disparity4Paths/... the same with 4 paths.
+//   BM_Disparity4PathsBaseline/... 4 paths on the build's baseline lanes
+//                          (SSE2, NEON) where the default would choose AVX2.
 //
+// The label names the backend the matcher ran on (DisparityBackend).
 // Counters: allocs_per_iter (must be 0), valid (share of pixels estimated).
 // The side-by-side figures against OpenCV's StereoSGBM on the Middlebury
 // pairs come from rtfuse_bench_opencv (tests/bench/opencv/).
@@ -53,17 +56,19 @@ BenchPair slanted_pair(int w, int h, int lo, int hi) {
   return p;
 }
 
-void run_disparity(benchmark::State& state, int paths) {
+void run_disparity(benchmark::State& state, int paths,
+                   rtfuse::vision::DisparityBackend backend = rtfuse::vision::DisparityBackend::kAuto) {
   const int w = static_cast<int>(state.range(0)), h = static_cast<int>(state.range(1));
   rtfuse::vision::DisparityParams params;
   params.disparities = static_cast<int>(state.range(2));
   params.downscale = static_cast<int>(state.range(3));
   params.paths = paths;
-  rtfuse::vision::SemiGlobalMatcher matcher(w, h, params);
+  rtfuse::vision::SemiGlobalMatcher matcher(w, h, params, backend);
   if (!matcher.valid()) {
     state.SkipWithError(matcher.error());
     return;
   }
+  state.SetLabel(rtfuse::vision::to_string(matcher.backend()));
   const BenchPair pair = slanted_pair(w, h, params.disparities / 8, params.disparities / 2);
   rtfuse::vision::Plane<std::uint16_t> out(matcher.output_width(w), matcher.output_height(h));
   const auto lv = rtfuse::vision::view_of(pair.left), rv = rtfuse::vision::view_of(pair.right);
@@ -88,6 +93,9 @@ void run_disparity(benchmark::State& state, int paths) {
 
 void BM_Disparity(benchmark::State& state) { run_disparity(state, 8); }
 void BM_Disparity4Paths(benchmark::State& state) { run_disparity(state, 4); }
+void BM_Disparity4PathsBaseline(benchmark::State& state) {
+  run_disparity(state, 4, rtfuse::vision::DisparityBackend::kBaseline);
+}
 
 void disparity_sizes(benchmark::internal::Benchmark* b) {
   b->ArgNames({"w", "h", "disp", "down"});
@@ -98,5 +106,6 @@ void disparity_sizes(benchmark::internal::Benchmark* b) {
 
 BENCHMARK(BM_Disparity)->Apply(disparity_sizes);
 BENCHMARK(BM_Disparity4Paths)->Apply(disparity_sizes);
+BENCHMARK(BM_Disparity4PathsBaseline)->Apply(disparity_sizes);
 
 }  // namespace

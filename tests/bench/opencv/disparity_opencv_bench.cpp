@@ -2,10 +2,14 @@
 // 4.6's StereoSGBM (test-only) on the Middlebury 2003 pairs of
 // RTFUSE_SHARED_DATA, one thread each (issue 27, docs/performance.md).
 //
-//   BM_SgbmSideBySide/<pair>/<paths>: each iteration runs OpenCV (MODE_SGBM,
-//   block 5, P1 = 8 * 25, P2 = 32 * 25, disp12MaxDiff 1, uniqueness 10,
-//   speckles 100 / 2, 64 disparities) and then ours on the same grey pair,
-//   timing each: interleaved, so both see the same machine. Counters: the
+//   BM_SgbmSideBySide/<pair>/<paths>/<simd>: each iteration runs OpenCV
+//   (MODE_SGBM, block 5, P1 = 8 * 25, P2 = 32 * 25, disp12MaxDiff 1,
+//   uniqueness 10, speckles 100 / 2, 64 disparities) and then ours on the
+//   same grey pair, timing each: interleaved, so both see the same machine.
+//   simd 0: ours on the fastest backend this CPU runs (AVX2 on most x86-64,
+//   chosen at run time as OpenCV chooses its own); 1: on the build's
+//   baseline (SSE2, NEON), to show what the dispatch gains. The label names
+//   the pair and the backend. Counters: the
 //   median ms of each, speedup = OpenCV / ours, and the share of known
 //   ground-truth pixels off by more than 1 px (unestimated counted as off),
 //   bad1_ours and bad1_opencv, in %. The benchmark's own time is the pair of
@@ -61,7 +65,6 @@ void BM_SgbmSideBySide(benchmark::State& state) {
     state.SkipWithError(error.c_str());
     return;
   }
-  state.SetLabel(kPairs[state.range(0)]);
   const int w = left.width, h = left.height;
   cv::setNumThreads(1);
   const cv::Mat l(h, w, CV_8UC1, left.pixels.data()), r(h, w, CV_8UC1, right.pixels.data());
@@ -70,7 +73,10 @@ void BM_SgbmSideBySide(benchmark::State& state) {
   cv::Mat cv_disp;
   rtfuse::vision::DisparityParams params;
   params.paths = static_cast<int>(state.range(1));
-  rtfuse::vision::SemiGlobalMatcher matcher(w, h, params);
+  const auto backend =
+      state.range(2) == 0 ? rtfuse::vision::DisparityBackend::kAuto : rtfuse::vision::DisparityBackend::kBaseline;
+  rtfuse::vision::SemiGlobalMatcher matcher(w, h, params, backend);
+  state.SetLabel(std::string(kPairs[state.range(0)]) + " " + rtfuse::vision::to_string(matcher.backend()));
   rtfuse::vision::Plane<std::uint16_t> ours(w, h);
   const rtfuse::vision::GreyView lv{left.pixels.data(), w, h, w}, rv{right.pixels.data(), w, h, w};
   std::vector<double> ms_cv, ms_ours;
@@ -98,11 +104,13 @@ void BM_SgbmSideBySide(benchmark::State& state) {
 }
 
 BENCHMARK(BM_SgbmSideBySide)
-    ->ArgNames({"pair", "paths"})
-    ->Args({0, 8})
-    ->Args({1, 8})
-    ->Args({0, 4})
-    ->Args({1, 4})
+    ->ArgNames({"pair", "paths", "simd"})
+    ->Args({0, 8, 0})
+    ->Args({1, 8, 0})
+    ->Args({0, 4, 0})
+    ->Args({1, 4, 0})
+    ->Args({0, 4, 1})
+    ->Args({1, 4, 1})
     ->Unit(benchmark::kMillisecond)
     ->MinTime(2.0);
 
