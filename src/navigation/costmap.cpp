@@ -37,6 +37,8 @@ Costmap::Costmap(int width, int height, const CostmapParams& params) : width_(wi
   }
   radius_ = static_cast<int>(std::ceil(params.inflation_radius_m / params.resolution_m));
   const std::size_t cells = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
+  grid_.reset(new std::int8_t[cells]);
+  std::fill(grid_.get(), grid_.get() + cells, std::int8_t{-1});
   kind_.reset(new std::uint8_t[cells]);
   std::fill(kind_.get(), kind_.get() + cells, kUnknownKind);
   cost_.reset(new std::uint8_t[cells]);
@@ -76,6 +78,7 @@ std::uint8_t Costmap::kind_of(std::int8_t value) const noexcept {
 
 void Costmap::set_grid(const std::int8_t* cells) noexcept {
   const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  std::copy(cells, cells + n, grid_.get());
   for (std::size_t i = 0; i < n; ++i) kind_[i] = kind_of(cells[i]);
   redo(0, 0, width_, height_);
   tiles_redone_ = static_cast<std::size_t>(tiles_x_) * static_cast<std::size_t>(tiles_y_);
@@ -84,14 +87,23 @@ void Costmap::set_grid(const std::int8_t* cells) noexcept {
 std::size_t Costmap::update(const std::int8_t* cells) noexcept {
   std::size_t changed = 0;
   std::size_t dirty_count = 0;
-  for (int y = 0; y < height_; ++y) {
-    const std::size_t row = static_cast<std::size_t>(y) * static_cast<std::size_t>(width_);
-    for (int x = 0; x < width_; ++x) {
-      const std::uint8_t kind = kind_of(cells[row + static_cast<std::size_t>(x)]);
-      if (kind == kind_[row + static_cast<std::size_t>(x)]) continue;
-      kind_[row + static_cast<std::size_t>(x)] = kind;
+  const std::size_t n = static_cast<std::size_t>(width_) * static_cast<std::size_t>(height_);
+  // Blocks of the grid compared as bytes first: a map changes in patches,
+  // and most of a 400 x 400 grid is the same from one second to the next.
+  constexpr std::size_t kBlock = 64;
+  for (std::size_t block = 0; block < n; block += kBlock) {
+    const std::size_t end = std::min(n, block + kBlock);
+    if (std::equal(cells + block, cells + end, grid_.get() + block)) continue;
+    for (std::size_t i = block; i < end; ++i) {
+      if (cells[i] == grid_[i]) continue;
+      grid_[i] = cells[i];
+      const std::uint8_t kind = kind_of(cells[i]);
+      if (kind == kind_[i]) continue;
+      kind_[i] = kind;
       ++changed;
       // Every tile within the radius of the cell: their costs may follow it.
+      const int x = static_cast<int>(i % static_cast<std::size_t>(width_));
+      const int y = static_cast<int>(i / static_cast<std::size_t>(width_));
       const int tx0 = std::max(0, x - radius_) / kTile, tx1 = std::min(width_ - 1, x + radius_) / kTile;
       const int ty0 = std::max(0, y - radius_) / kTile, ty1 = std::min(height_ - 1, y + radius_) / kTile;
       for (int ty = ty0; ty <= ty1; ++ty) {

@@ -59,6 +59,7 @@ class Costmap {
   int height_ = 0;
   CostmapParams params_;
   int radius_ = 0;                             // in cells
+  std::unique_ptr<std::int8_t[]> grid_;        // the grid last given, to find what changed
   std::unique_ptr<std::uint8_t[]> kind_;       // per cell: free, obstacle, unknown
   std::unique_ptr<std::uint8_t[]> cost_;       // per cell
   std::unique_ptr<std::uint8_t[]> cost_at_;    // by squared distance in cells, 0..radius^2
