@@ -9,6 +9,16 @@ namespace rtfuse::navigation {
 namespace {
 
 constexpr int kTile = 16;
+
+// A length in cells; one a rounding away from a whole number is that
+// number: 0.15 m at 0.05 m is 3 cells, where the division gives
+// 2.9999999999999996 and 3 x 0.05 gives 0.15000000000000002, and a cell
+// exactly at the inscribed radius would otherwise fall outside it.
+double cells_of(double metres, double resolution) {
+  const double x = metres / resolution;
+  const double whole = std::round(x);
+  return std::fabs(x - whole) <= 1e-9 * std::max(1.0, whole) ? whole : x;
+}
 enum : std::uint8_t { kFreeKind = 0, kObstacleKind = 1, kUnknownKind = 2 };
 
 }  // namespace
@@ -22,7 +32,7 @@ std::string check(const CostmapParams& p) {
   if (!(p.cost_scaling_factor >= 0.0 && p.cost_scaling_factor <= 1000.0)) {
     return "cost scaling factor must be in [0, 1000]";
   }
-  if (!(std::ceil(p.inflation_radius_m / p.resolution_m) <= 250.0)) {
+  if (!(std::ceil(cells_of(p.inflation_radius_m, p.resolution_m)) <= 250.0)) {
     return "inflation radius must be at most 250 cells";
   }
   if (p.occupied_from < 1 || p.occupied_from > 100) return "occupied_from must be in [1, 100]";
@@ -35,7 +45,7 @@ Costmap::Costmap(int width, int height, const CostmapParams& params) : width_(wi
   if (width <= 0 || height <= 0 || width > 16384 || height > 16384) {
     throw std::invalid_argument("costmap: width and height must be in [1, 16384] cells");
   }
-  radius_ = static_cast<int>(std::ceil(params.inflation_radius_m / params.resolution_m));
+  radius_ = static_cast<int>(std::ceil(cells_of(params.inflation_radius_m, params.resolution_m)));
   const std::size_t cells = static_cast<std::size_t>(width) * static_cast<std::size_t>(height);
   grid_.reset(new std::int8_t[cells]);
   std::fill(grid_.get(), grid_.get() + cells, std::int8_t{-1});
@@ -45,18 +55,22 @@ Costmap::Costmap(int width, int height, const CostmapParams& params) : width_(wi
   vertical_.reset(new std::uint16_t[cells]);
   // costmap_2d's computeCost, once per squared distance: the costs are a
   // function of the configuration only, so the exp's last bit cannot make
-  // two runs differ.
+  // two runs differ. Inscribed is decided in cells (d2 against the radius
+  // in cells squared), so the rounding of metres cannot open a cell the
+  // radius closes.
   const int r2 = radius_ * radius_;
+  const double inscribed = cells_of(params.inscribed_radius_m, params.resolution_m);
   cost_at_.reset(new std::uint8_t[static_cast<std::size_t>(r2) + 1]);
   for (int d2 = 0; d2 <= r2; ++d2) {
-    const double d = std::sqrt(static_cast<double>(d2)) * params.resolution_m;
+    const double d = std::sqrt(static_cast<double>(d2));  // in cells
     std::uint8_t c;
     if (d2 == 0) {
       c = kCostLethal;
-    } else if (d <= params.inscribed_radius_m) {
+    } else if (d2 <= inscribed * inscribed * (1.0 + 1e-12)) {
       c = kCostInscribed;
     } else {
-      const double factor = std::exp(-params.cost_scaling_factor * (d - params.inscribed_radius_m));
+      const double factor =
+          std::exp(-params.cost_scaling_factor * (d * params.resolution_m - params.inscribed_radius_m));
       c = static_cast<std::uint8_t>((kCostInscribed - 1) * factor);
     }
     cost_at_[static_cast<std::size_t>(d2)] = c;

@@ -30,11 +30,17 @@ std::vector<std::int8_t> free_grid(int w, int h) { return std::vector<std::int8_
 
 // What costmap_2d gives a free cell at d cells from the nearest obstacle
 // cell, written out from its computeCost.
+// Radii are whole cells when they are a rounding away from one (0.15 m at
+// 0.05 m is 3 cells, not 2.9999999999999996).
 int expected_cost(const CostmapParams& p, double d_cells) {
-  const int radius = static_cast<int>(std::ceil(p.inflation_radius_m / p.resolution_m));
+  const auto cells = [&](double m) {
+    const double x = m / p.resolution_m;
+    return std::fabs(x - std::round(x)) < 1e-9 ? std::round(x) : x;
+  };
+  const int radius = static_cast<int>(std::ceil(cells(p.inflation_radius_m)));
   if (d_cells == 0.0) return 254;
   if (d_cells > radius) return 0;
-  if (d_cells * p.resolution_m <= p.inscribed_radius_m) return 253;
+  if (d_cells <= cells(p.inscribed_radius_m) + 1e-12) return 253;
   return static_cast<int>(252.0 * std::exp(-p.cost_scaling_factor * (d_cells * p.resolution_m - p.inscribed_radius_m)));
 }
 
@@ -135,6 +141,25 @@ TEST(Costmap, UpdatesEqualACostmapMadeAnewAndRedoOnlyTilesNearChanges) {
   // Nothing changed: nothing redone.
   EXPECT_EQ(kept.update(grid.data()), 0u);
   EXPECT_EQ(kept.tiles_redone(), 0u);
+}
+
+TEST(Costmap, ACellExactlyAtTheInscribedRadiusIsInscribed) {
+  // 0.15 / 0.05 is 2.9999999999999996 and 3 x 0.05 is 0.15000000000000002:
+  // the cell 3 cells away is inscribed all the same, and the one 4 away
+  // (the inflation radius, 0.2 m) inflated.
+  CostmapParams p = robot();
+  p.inscribed_radius_m = 0.15;
+  p.inflation_radius_m = 0.2;
+  const int w = 20, h = 20;
+  Costmap map(w, h, p);
+  std::vector<std::int8_t> grid = free_grid(w, h);
+  grid[10 * w + 10] = 100;
+  map.set_grid(grid.data());
+  EXPECT_EQ(map.radius_cells(), 4);
+  EXPECT_EQ(map.cost(13, 10), 253);
+  EXPECT_EQ(map.cost(14, 10), expected_cost(p, 4.0));
+  EXPECT_LT(map.cost(14, 10), 253);
+  EXPECT_EQ(map.cost(15, 10), 0);
 }
 
 TEST(Costmap, UnknownCellsReadAsConfigured) {
