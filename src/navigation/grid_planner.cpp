@@ -1,5 +1,6 @@
 #include "navigation/grid_planner.hpp"
 
+#include <cmath>
 #include <cstdlib>
 #include <stdexcept>
 #include <string>
@@ -8,8 +9,14 @@ namespace rtfuse::navigation {
 
 namespace {
 
-constexpr std::uint32_t kClosed = 0xFFFFFFFFu;
-constexpr std::size_t kMaxWorkspaceCells = std::size_t{1} << 31;
+constexpr int kMaxSide = 65535;                           // a coordinate fits an entry's 16 bits
+constexpr std::size_t kMaxCells = std::size_t{1} << 28;  // an entry's index fits 29 bits
+constexpr std::uint32_t kNoEntry = 0x1FFFFFFFu;
+constexpr std::uint32_t kMaxBuckets = 8192;
+constexpr int kFractionBits = 32;
+constexpr int kBucketBits = 4;  // buckets 1/16 of a cell wide
+// Every f of a search stays below this, so no sum overflows.
+constexpr double kFixedPointLimit = 4.0e18;
 
 // The 8 steps: the four orthogonal first (E, N, W, S), then the diagonals
 // (NE, NW, SW, SE), each between two of them.
@@ -22,94 +29,89 @@ bool inside(const CostView& grid, GridCell c) noexcept {
 
 }  // namespace
 
-// A cell's cost from the start as its two sums: the factors of its
-// straight steps (a) and of its diagonal ones (b), g = a + sqrt(2) b. Over
-// free cells both are small integers, exact, so routes of equal length
-// have equal g and f, and the open list's tie-break (larger g) sees them
-// as equal instead of ordering them by rounding noise.
+// A cell's state in the plan whose stamp it holds: its cost from the start
+// (fixed point), its newest open-list entry (kNoEntry when it has none
+// waiting) and the step that reached it, in one word.
 struct GridPlanner::Node {
-  double a;
-  double b;
-  std::uint32_t stamp;  // the plan that last reached the cell; a, b and slot are that plan's
-  std::uint32_t slot;   // its place in the open list, or kClosed once expanded
+  std::int64_t g;
+  std::uint32_t stamp;
+  std::uint32_t link;  // entry << 3 | step
+
+  std::uint32_t entry() const noexcept { return link >> 3; }
+  std::uint32_t step() const noexcept { return link & 7u; }
 };
 
-struct GridPlanner::OpenEntry {
-  double f;
-  double g;
-  std::uint32_t cell;
+// An open-list entry: the cell's f when it was entered, the cell, and the
+// next entry of its bucket.
+struct GridPlanner::Entry {
+  std::int64_t f;
+  std::uint16_t x;
+  std::uint16_t y;
+  std::uint32_t next;
 };
-
-namespace {
-
-// The open list's order: f, then larger g, then the smaller cell index. A
-// total order on distinct cells, so the search is the same on every run.
-template <typename Entry>
-bool before(const Entry& a, const Entry& b) noexcept {
-  if (a.f != b.f) return a.f < b.f;
-  if (a.g != b.g) return a.g > b.g;
-  return a.cell < b.cell;
-}
-
-// f = g + h for a cell reached with sums (a, b) at (x, y): h is the
-// octile distance to the goal, the cost of the cheapest route on an empty
-// grid (every factor 1), hi - lo straight steps and lo diagonal ones,
-// added to a and b before sqrt(2) multiplies. Dijkstra's h is 0.
-template <bool kAStar>
-double f_of(double a, double b, int x, int y, int gx, int gy) noexcept {
-  if constexpr (kAStar) {
-    const int dx = std::abs(x - gx);
-    const int dy = std::abs(y - gy);
-    const int lo = dx < dy ? dx : dy;
-    const int hi = dx < dy ? dy : dx;
-    return (a + static_cast<double>(hi - lo)) + kSqrt2 * (b + static_cast<double>(lo));
-  } else {
-    static_cast<void>(x);
-    static_cast<void>(y);
-    static_cast<void>(gx);
-    static_cast<void>(gy);
-    return a + kSqrt2 * b;
-  }
-}
-
-}  // namespace
 
 double step_factor(std::uint8_t cost, double cost_weight) noexcept {
   const double c = cost == kCostUnknown ? 0.0 : static_cast<double>(cost);
   return 1.0 + cost_weight * c / 252.0;
 }
 
-GridPlanner::GridPlanner(int max_width, int max_height, std::size_t max_path_cells)
+GridPlanner::GridPlanner(int max_width, int max_height, std::size_t max_path_cells, std::size_t open_entries)
     : max_width_(max_width), max_height_(max_height), max_path_(max_path_cells) {
-  if (max_width < 1 || max_height < 1 || max_path_cells < 1) {
+  if (max_width < 1 || max_height < 1 || max_width > kMaxSide || max_height > kMaxSide || max_path_cells < 1) {
     throw std::invalid_argument("grid planner: workspace of " + std::to_string(max_width) + " x " +
                                 std::to_string(max_height) + " cells and a path of " + std::to_string(max_path_cells) +
-                                " cells: each must be at least 1");
+                                " cells: sides must be in [1, 65535], the path at least 1");
   }
   cells_ = static_cast<std::size_t>(max_width) * static_cast<std::size_t>(max_height);
-  if (cells_ >= kMaxWorkspaceCells) {
-    throw std::invalid_argument("grid planner: workspace of " + std::to_string(cells_) +
-                                " cells: at most 2^31 - 1");
+  if (cells_ >= kMaxCells) {
+    throw std::invalid_argument("grid planner: workspace of " + std::to_string(cells_) + " cells: at most 2^28 - 1");
+  }
+  pool_size_ = open_entries == 0 ? 2 * cells_ : open_entries;
+  if (pool_size_ >= kNoEntry) {
+    throw std::invalid_argument("grid planner: an open list of " + std::to_string(pool_size_) +
+                                " entries: at most 2^29 - 2");
   }
   nodes_.reset(new Node[cells_]);
-  for (std::size_t i = 0; i < cells_; ++i) nodes_[i] = Node{0.0, 0.0, 0, kClosed};
-  parent_.reset(new std::uint8_t[cells_]());
-  open_.reset(new OpenEntry[cells_]);
+  for (std::size_t i = 0; i < cells_; ++i) nodes_[i] = Node{0, 0, kNoEntry << 3};
+  pool_.reset(new Entry[pool_size_]);
+  head_.reset(new std::uint32_t[kMaxBuckets]);
   path_.reset(new GridCell[max_path_]);
 }
 
 GridPlanner::~GridPlanner() = default;
 
 std::size_t GridPlanner::workspace_bytes() const noexcept {
-  return cells_ * (sizeof(Node) + sizeof(std::uint8_t) + sizeof(OpenEntry)) + max_path_ * sizeof(GridCell);
+  return cells_ * sizeof(Node) + pool_size_ * sizeof(Entry) + kMaxBuckets * sizeof(std::uint32_t) +
+         max_path_ * sizeof(GridCell);
 }
 
-void GridPlanner::make_tables(const PlannerParams& params) noexcept {
+void GridPlanner::make_tables(const PlannerParams& params, std::size_t cells) noexcept {
+  double most = 1.0;  // the largest factor of a passable cell
   for (int c = 0; c < 256; ++c) {
     const auto cost = static_cast<std::uint8_t>(c);
     passable_[c] = params.passability.passable(cost);
     factor_[c] = step_factor(cost, params.cost_weight);
+    if (passable_[c] && factor_[c] > most) most = factor_[c];
   }
+  // A route visits each cell once at most, h is at most the grid's
+  // octile diameter: f < 2 sqrt(2) most cells in cells, kept under 2^62.
+  int bits = kFractionBits;
+  while (bits > 0 && std::ldexp(2.0 * kSqrt2 * most * static_cast<double>(cells + 2), bits) > kFixedPointLimit) --bits;
+  fraction_bits_ = bits;
+  for (int c = 0; c < 256; ++c) {
+    straight_[c] = std::llround(std::ldexp(factor_[c], bits));
+    diagonal_[c] = std::llround(std::ldexp(kSqrt2 * factor_[c], bits));
+  }
+  // An entry's f is at most two of the largest diagonal steps above the f
+  // of the cell that entered it, itself in the lowest bucket: the buckets
+  // in use span that much, and wider buckets keep their number bounded.
+  const double spread = 2.0 * kSqrt2 * most + 1.0;
+  int shift = bits - kBucketBits;
+  if (shift < 0) shift = 0;
+  while (std::ldexp(spread, bits - shift) > static_cast<double>(kMaxBuckets - 4)) ++shift;
+  bucket_shift_ = shift;
+  buckets_ = 16;
+  while (static_cast<double>(buckets_) < std::ldexp(spread, bits - shift) + 4.0) buckets_ *= 2;
 }
 
 void GridPlanner::next_stamp() noexcept {
@@ -119,46 +121,47 @@ void GridPlanner::next_stamp() noexcept {
   }
 }
 
-void GridPlanner::sift_up(std::uint32_t slot, OpenEntry entry) noexcept {
-  while (slot > 0) {
-    const std::uint32_t up = (slot - 1) / 2;
-    if (!before(entry, open_[up])) break;
-    open_[slot] = open_[up];
-    nodes_[open_[slot].cell].slot = slot;
-    slot = up;
-  }
-  open_[slot] = entry;
-  nodes_[entry.cell].slot = slot;
-}
+// What compact() leaves: the free entries' list and how many are in use.
+struct GridPlanner::Compacted {
+  std::uint32_t free_list;
+  std::uint32_t live;
+};
 
-void GridPlanner::push(std::uint32_t cell, double g, double f) noexcept {
-  sift_up(open_size_++, OpenEntry{f, g, cell});
-}
-
-GridPlanner::OpenEntry GridPlanner::pop() noexcept {
-  const OpenEntry top = open_[0];
-  nodes_[top.cell].slot = kClosed;
-  const std::uint32_t size = --open_size_;
-  if (size > 0) {
-    const OpenEntry last = open_[size];
-    std::uint32_t slot = 0;
-    for (;;) {
-      std::uint32_t child = 2 * slot + 1;
-      if (child >= size) break;
-      if (child + 1 < size && before(open_[child + 1], open_[child])) ++child;
-      if (!before(open_[child], last)) break;
-      open_[slot] = open_[child];
-      nodes_[open_[slot].cell].slot = slot;
-      slot = child;
+// Drops the entries no cell points to any more (older entries of cells
+// improved since, and cells already expanded) from the buckets to the
+// free list. At most one entry per cell is left, so a pool larger than the
+// grid always gains room; a smaller one may not, and the search then ends
+// (kOpenListFull). Takes and returns values, so that the search's
+// counters stay in registers (their addresses never taken).
+GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t stamp, std::uint32_t buckets,
+                                            std::uint32_t free_list, std::uint32_t live) noexcept {
+  ++compactions_;
+  Entry* const pool = pool_.get();
+  const Node* const nodes = nodes_.get();
+  for (std::uint32_t b = 0; b < buckets; ++b) {
+    std::uint32_t* link = &head_[b];
+    while (*link != kNoEntry) {
+      const std::uint32_t idx = *link;
+      Entry& e = pool[idx];
+      const Node& n = nodes[static_cast<std::uint32_t>(e.y) * row + e.x];
+      if (n.stamp == stamp && n.entry() == idx) {
+        link = &e.next;
+      } else {
+        *link = e.next;
+        e.next = free_list;
+        free_list = idx;
+        --live;
+      }
     }
-    open_[slot] = last;
-    nodes_[last.cell].slot = slot;
   }
-  return top;
+  return Compacted{free_list, live};
 }
 
-// The search itself, A* (the octile heuristic) or Dijkstra (none). Returns
-// whether the goal was reached; its g and the parents then hold the path.
+// The search: A* (the octile heuristic) or Dijkstra (none), with reopening
+// over the bucket queue. Returns whether the goal was reached; the cells'
+// steps then lead back from it. Everything it changes per step is a local
+// whose address is never taken: stores through the pools' pointers could
+// otherwise alias it and force it back to memory at every step.
 template <bool kAStar>
 bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, PlanResult& result) noexcept {
   const int width = grid.width;
@@ -166,66 +169,148 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   const std::uint8_t* const cost = grid.cost;
   const int gx = goal.x;
   const int gy = goal.y;
-  const auto goal_index = static_cast<std::uint32_t>(gy * width + gx);
-  const auto relax = [this, gx, gy](std::uint32_t v, int x, int y, double a, double b, std::uint8_t step) noexcept {
-    Node& node = nodes_[v];
-    const double g = a + kSqrt2 * b;
-    if (node.stamp != stamp_) {
-      node.stamp = stamp_;
-      node.a = a;
-      node.b = b;
-      parent_[v] = step;
-      push(v, g, f_of<kAStar>(a, b, x, y, gx, gy));
-    } else if (node.slot != kClosed && g < node.a + kSqrt2 * node.b) {
-      node.a = a;
-      node.b = b;
-      parent_[v] = step;
-      sift_up(node.slot, OpenEntry{f_of<kAStar>(a, b, x, y, gx, gy), g, v});
+  const auto row = static_cast<std::uint32_t>(width);
+  const std::uint32_t goal_index = static_cast<std::uint32_t>(gy) * row + static_cast<std::uint32_t>(gx);
+  // The octile distance in the fixed point: hi - lo straight steps and lo
+  // diagonal ones of factor 1, each the same integer a step's cost is.
+  const std::int64_t unit = straight_[kCostFree];
+  const std::int64_t diagonal_unit = diagonal_[kCostFree];
+  const auto h_of = [=](int x, int y) noexcept -> std::int64_t {
+    if constexpr (kAStar) {
+      const int dx = std::abs(x - gx);
+      const int dy = std::abs(y - gy);
+      const int lo = dx < dy ? dx : dy;
+      const int hi = dx < dy ? dy : dx;
+      return static_cast<std::int64_t>(hi - lo) * unit + static_cast<std::int64_t>(lo) * diagonal_unit;
+    } else {
+      static_cast<void>(x);
+      static_cast<void>(y);
+      return 0;
     }
   };
+  bool passable[256];
+  std::int64_t straight[256];
+  std::int64_t diagonal[256];
+  for (int c = 0; c < 256; ++c) {
+    passable[c] = passable_[c];
+    straight[c] = straight_[c];
+    diagonal[c] = diagonal_[c];
+  }
+  Node* const nodes = nodes_.get();
+  Entry* const pool = pool_.get();
+  std::uint32_t* const head = head_.get();
+  const auto pool_size = static_cast<std::uint32_t>(pool_size_);
+  const std::uint32_t stamp = stamp_;
+  const std::uint32_t buckets = buckets_;
+  const std::uint32_t mask = buckets - 1;
+  const int shift = bucket_shift_;
+  const std::int64_t f0 = h_of(start.x, start.y);  // bucket 0 begins at the start's f
+  for (std::uint32_t k = 0; k < buckets; ++k) head[k] = kNoEntry;
+  std::uint64_t current = 0;  // the bucket being taken, counted from bucket 0 (not modulo)
+  std::uint32_t free_list = kNoEntry;
+  std::uint32_t unused = 0;  // entries never used yet start here
+  std::uint32_t live = 0;    // entries in the buckets
+  bool full = false;         // an open list smaller than the grid held only needed entries
+  // The goal's cost so far: an upper bound. Entries at or above it cannot
+  // lead to a cheaper route and are neither entered nor expanded.
+  std::int64_t best = INT64_MAX;
 
-  open_size_ = 0;
-  const auto start_index = static_cast<std::uint32_t>(start.y * width + start.x);
-  nodes_[start_index].stamp = stamp_;
-  nodes_[start_index].a = 0.0;
-  nodes_[start_index].b = 0.0;
-  push(start_index, 0.0, f_of<kAStar>(0.0, 0.0, start.x, start.y, gx, gy));
-  const auto row = static_cast<std::uint32_t>(width);
-  std::size_t expansions = 0;
-  while (open_size_ > 0) {
-    const std::uint32_t u = pop().cell;
-    ++expansions;
-    if (u == goal_index) {
-      result.expansions = expansions;
-      return true;
+  const auto push = [&](int x, int y, std::int64_t f) noexcept -> std::uint32_t {
+    const std::int64_t above = f - f0;
+    std::uint64_t k = above > 0 ? static_cast<std::uint64_t>(above) >> shift : 0;
+    // Never behind the bucket being taken, never past the window (neither
+    // happens with exact consistent costs; an earlier bucket than its f's
+    // would only be taken early, which the search allows).
+    if (k < current) k = current;
+    if (k > current + buckets - 2) k = current + buckets - 2;
+    if (free_list == kNoEntry && unused == pool_size) {
+      const Compacted left = compact(row, stamp, buckets, free_list, live);
+      free_list = left.free_list;
+      live = left.live;
+      if (free_list == kNoEntry) {
+        full = true;
+        return kNoEntry;
+      }
     }
-    const int y = static_cast<int>(u / row);
-    const int x = static_cast<int>(u - static_cast<std::uint32_t>(y) * row);
+    std::uint32_t idx;
+    if (free_list != kNoEntry) {
+      idx = free_list;
+      free_list = pool[idx].next;
+    } else {
+      idx = unused++;
+    }
+    const auto slot = static_cast<std::uint32_t>(k) & mask;
+    pool[idx] = Entry{f, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), head[slot]};
+    head[slot] = idx;
+    ++live;
+    return idx;
+  };
+  const auto relax = [&](std::uint32_t v, int x, int y, std::int64_t g, std::uint32_t step) noexcept {
+    Node& node = nodes[v];
+    if (node.stamp == stamp && g >= node.g) return;
+    node.stamp = stamp;
+    node.g = g;
+    if (v == goal_index) {  // never expanded: nothing beyond it can make it cheaper
+      best = g;
+      node.link = (kNoEntry << 3) | step;
+      return;
+    }
+    const std::int64_t f = g + h_of(x, y);
+    node.link = ((f < best ? push(x, y, f) : kNoEntry) << 3) | step;
+  };
+
+  const std::uint32_t start_index = static_cast<std::uint32_t>(start.y) * row + static_cast<std::uint32_t>(start.x);
+  nodes[start_index].stamp = stamp;
+  nodes[start_index].g = 0;
+  nodes[start_index].link = push(start.x, start.y, f0) << 3;
+  std::size_t expansions = 0;
+  while (live > 0 && !full) {
+    const std::uint32_t slot = static_cast<std::uint32_t>(current) & mask;
+    const std::uint32_t idx = head[slot];
+    if (idx == kNoEntry) {  // the bucket is done: stop once the next starts at the goal's cost
+      ++current;
+      if (static_cast<std::int64_t>(current << shift) >= best - f0) break;
+      continue;
+    }
+    const Entry e = pool[idx];
+    head[slot] = e.next;
+    pool[idx].next = free_list;
+    free_list = idx;
+    --live;
+    const int x = e.x;
+    const int y = e.y;
+    const std::uint32_t u = static_cast<std::uint32_t>(y) * row + static_cast<std::uint32_t>(x);
+    Node& node = nodes[u];
+    if (node.entry() != idx) continue;  // an older entry of a cell improved since
+    node.link |= kNoEntry << 3;
+    if (e.f >= best) continue;
+    ++expansions;
     const std::uint8_t* const c = cost + u;
-    const double a = nodes_[u].a;
-    const double b = nodes_[u].b;
+    const std::int64_t g = node.g;
     // The orthogonal neighbours' passability (false outside the grid)
     // decides the diagonals too: no step past a blocked corner.
-    const bool east = x + 1 < width && passable_[c[1]];
-    const bool north = y + 1 < height && passable_[c[width]];
-    const bool west = x > 0 && passable_[c[-1]];
-    const bool south = y > 0 && passable_[c[-width]];
-    if (east) relax(u + 1, x + 1, y, a + factor_[c[1]], b, 0);
-    if (north) relax(u + row, x, y + 1, a + factor_[c[width]], b, 1);
-    if (west) relax(u - 1, x - 1, y, a + factor_[c[-1]], b, 2);
-    if (south) relax(u - row, x, y - 1, a + factor_[c[-width]], b, 3);
-    if (east && north && passable_[c[width + 1]]) relax(u + row + 1, x + 1, y + 1, a, b + factor_[c[width + 1]], 4);
-    if (west && north && passable_[c[width - 1]]) relax(u + row - 1, x - 1, y + 1, a, b + factor_[c[width - 1]], 5);
-    if (west && south && passable_[c[-width - 1]]) relax(u - row - 1, x - 1, y - 1, a, b + factor_[c[-width - 1]], 6);
-    if (east && south && passable_[c[-width + 1]]) relax(u - row + 1, x + 1, y - 1, a, b + factor_[c[-width + 1]], 7);
+    const bool east = x + 1 < width && passable[c[1]];
+    const bool north = y + 1 < height && passable[c[width]];
+    const bool west = x > 0 && passable[c[-1]];
+    const bool south = y > 0 && passable[c[-width]];
+    if (east) relax(u + 1, x + 1, y, g + straight[c[1]], 0);
+    if (north) relax(u + row, x, y + 1, g + straight[c[width]], 1);
+    if (west) relax(u - 1, x - 1, y, g + straight[c[-1]], 2);
+    if (south) relax(u - row, x, y - 1, g + straight[c[-width]], 3);
+    if (east && north && passable[c[width + 1]]) relax(u + row + 1, x + 1, y + 1, g + diagonal[c[width + 1]], 4);
+    if (west && north && passable[c[width - 1]]) relax(u + row - 1, x - 1, y + 1, g + diagonal[c[width - 1]], 5);
+    if (west && south && passable[c[-width - 1]]) relax(u - row - 1, x - 1, y - 1, g + diagonal[c[-width - 1]], 6);
+    if (east && south && passable[c[-width + 1]]) relax(u - row + 1, x + 1, y - 1, g + diagonal[c[-width + 1]], 7);
   }
   result.expansions = expansions;
-  return false;
+  if (full) result.status = PlanStatus::kOpenListFull;
+  return !full && best < INT64_MAX;
 }
 
 PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal,
                              const PlannerParams& params) noexcept {
   PlanResult result;
+  compactions_ = 0;
   const double w = params.cost_weight;
   if (!grid.valid() || !params.passability.valid() || !(w >= 0.0 && w <= kMaxCostWeight)) {
     result.status = PlanStatus::kInvalidInput;
@@ -253,40 +338,55 @@ PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal
     result.status = goal_cost == kCostUnknown ? PlanStatus::kGoalUnknown : PlanStatus::kGoalInObstacle;
     return result;
   }
-
-  make_tables(params);
-  next_stamp();
-  const bool found = params.mode == SearchMode::kAStar ? search<true>(grid, start, goal, result)
-                                                       : search<false>(grid, start, goal, result);
-  if (!found) {
-    result.status = PlanStatus::kNoRoute;
-    return result;
-  }
-
-  // Back from the goal along the steps that reached each cell: count, then
-  // write start to goal.
-  const int width = grid.width;
-  const auto start_index = static_cast<std::uint32_t>(start.y * width + start.x);
-  const auto goal_index = static_cast<std::uint32_t>(goal.y * width + goal.x);
-  result.cost = nodes_[goal_index].a + kSqrt2 * nodes_[goal_index].b;
   std::size_t cells = 1;
-  for (std::uint32_t i = goal_index; i != start_index; ++cells) {
-    const std::uint8_t step = parent_[i];
-    i = static_cast<std::uint32_t>(static_cast<int>(i) - kStepY[step] * width - kStepX[step]);
+  if (start != goal) {
+    make_tables(params, static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height));
+    next_stamp();
+    const bool found = params.mode == SearchMode::kAStar ? search<true>(grid, start, goal, result)
+                                                         : search<false>(grid, start, goal, result);
+    if (!found) {
+      if (result.status != PlanStatus::kOpenListFull) result.status = PlanStatus::kNoRoute;
+      return result;
+    }
+    // Back from the goal along the steps that reached each cell: count...
+    const auto row = static_cast<std::size_t>(grid.width);
+    const auto step_of = [&](GridCell c) {
+      return nodes_[static_cast<std::size_t>(c.y) * row + static_cast<std::size_t>(c.x)].step();
+    };
+    for (GridCell c = goal; c != start; ++cells) {
+      const std::uint32_t step = step_of(c);
+      c.x -= kStepX[step];
+      c.y -= kStepY[step];
+    }
+    if (cells > max_path_) {
+      result.status = PlanStatus::kPathTooLong;
+      result.cost = std::ldexp(static_cast<double>(nodes_[static_cast<std::size_t>(goal.y) * row +
+                                                          static_cast<std::size_t>(goal.x)].g),
+                               -fraction_bits_);
+      return result;
+    }
+    // ...then write start to goal.
+    GridCell c = goal;
+    for (std::size_t k = cells - 1; k > 0; --k) {
+      path_[k] = c;
+      const std::uint32_t step = step_of(c);
+      c.x -= kStepX[step];
+      c.y -= kStepY[step];
+    }
   }
-  if (cells > max_path_) {
-    result.status = PlanStatus::kPathTooLong;
-    return result;
+  path_[0] = start;
+  // The cost in double, from the path itself.
+  double straight = 0.0;
+  double diagonal = 0.0;
+  for (std::size_t k = 1; k < cells; ++k) {
+    const double f = step_factor(grid.at(path_[k].x, path_[k].y), params.cost_weight);
+    if (path_[k].x != path_[k - 1].x && path_[k].y != path_[k - 1].y) {
+      diagonal = diagonal + f;
+    } else {
+      straight = straight + f;
+    }
   }
-  GridCell c = goal;
-  for (std::size_t k = cells; k-- > 0;) {
-    path_[k] = c;
-    if (k == 0) break;
-    const std::uint8_t step = parent_[static_cast<std::size_t>(c.y) * static_cast<std::size_t>(width) +
-                                      static_cast<std::size_t>(c.x)];
-    c.x -= kStepX[step];
-    c.y -= kStepY[step];
-  }
+  result.cost = straight + kSqrt2 * diagonal;
   result.status = PlanStatus::kOk;
   result.path = path_.get();
   result.path_cells = cells;

@@ -18,22 +18,35 @@
 // the graph is the plain one: steps of 1 and sqrt(2). The default weight,
 // 2, is Nav2's Smac 2D planner's cost_travel_multiplier, the same term.
 //
+// The search. Costs are summed in fixed point, 2^-32 of a cell (a step's
+// cost rounded once to that, so a route's cost is within 2^-33 of a cell
+// per step of its exact value, 1e-10 relative): integer sums are exact
+// and associative, so equal routes tie exactly, the heuristic is
+// consistent exactly, and the arithmetic is the same on every machine.
+// The open list is a bucket queue: f in buckets 1/16 of a cell wide
+// (wider for large weights: 8192 buckets at most), taken in order, last
+// in first out within a bucket (so on open ground A* walks straight to
+// the goal). Within a bucket f is not sorted, so a cell can be expanded
+// before its cheapest route is known; it is expanded again when that
+// route arrives. The search stops when the lowest bucket left starts at
+// or above the goal's cost (every route still open costs at least that):
+// the cost is the optimum of the graph, to the fixed point's rounding. A
+// push or a pop is O(1) where a binary heap sifts through its levels
+// (docs/design.md, "Navigation: the grid planner", says what that was
+// worth). The reported cost is the path's own, in double: the factors of
+// its straight steps summed from the start, plus sqrt(2) times those of
+// its diagonal steps.
+//
 // Deterministic: the same grid, cells and parameters give the same path
-// on every run and on x86-64 and aarch64: IEEE double operations one at a
-// time (the build does not contract multiply-adds), the factors from a
-// table made per plan, sqrt(2) a constant. A cell's cost from the start is
-// kept as two sums, a of its straight steps' factors and b of its diagonal
-// ones, g = a + sqrt(2) b: over free cells a and b are exact integers, so
-// equally long routes tie exactly instead of by rounding noise. The open
-// list orders by f = g + h, then larger g (of equal-f cells the one nearer
-// the goal: on open ground A* walks straight to it), then the smaller cell
-// index.
+// and counts on every run and on x86-64 and aarch64: integer search, the
+// factors and the reported cost IEEE double operations one at a time (the
+// build does not contract multiply-adds), sqrt(2) a constant.
 //
 // Fixed workspace: everything is allocated by the constructor for grids up
 // to max_width x max_height and paths up to max_path_cells; plan()
 // allocates nothing and never throws. A search keeps no state between
-// plans: a per-cell stamp says which plan last saw the cell, so nothing is
-// cleared per plan either.
+// plans: a per-cell stamp says which plan last saw the cell, so nothing
+// the size of the grid is cleared per plan either.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -47,8 +60,10 @@ namespace rtfuse::navigation {
 
 // sqrt(2) rounded to the nearest double (what std::sqrt(2.0) gives).
 inline constexpr double kSqrt2 = 1.4142135623730951;
-// Weights above this are refused: a route's cost must stay finite.
-inline constexpr double kMaxCostWeight = 1.0e6;
+// Weights above this are refused. The fixed point keeps 32 fraction bits
+// unless a route on the grid could then overflow 62 bits (weight 2: grids
+// of over 100 M cells; weight 1000: over 320 000), then fewer, 22 at least.
+inline constexpr double kMaxCostWeight = 1000.0;
 
 enum class SearchMode : std::uint8_t {
   kAStar,     // octile heuristic: fewer cells expanded
@@ -71,12 +86,14 @@ struct PlanResult {
   // planner's buffer, valid until its next plan(). Empty unless kOk.
   const GridCell* path = nullptr;
   std::size_t path_cells = 0;
-  // The path's cost in cells (kOk and kPathTooLong; 0 otherwise): its
-  // straight steps' factors summed from the start, plus sqrt(2) times its
-  // diagonal steps' factors summed from the start. Equal to the sum of the
-  // step costs to rounding.
+  // The path's cost in cells: its straight steps' factors summed from the
+  // start, plus sqrt(2) times its diagonal steps' factors summed from the
+  // start, equal to the sum of the step costs to rounding (kOk); the
+  // search's fixed-point cost (kPathTooLong); 0 otherwise.
   double cost = 0.0;
-  // Cells taken off the open list and expanded (the goal's pop included).
+  // Cells expanded (their neighbours relaxed), each time it happened: a
+  // cell expanded again when a cheaper route to it arrives counts twice.
+  // The goal is never expanded; start == goal expands nothing.
   std::size_t expansions = 0;
 
   bool ok() const noexcept { return status == PlanStatus::kOk; }
@@ -85,8 +102,13 @@ struct PlanResult {
 class GridPlanner {
  public:
   // Allocates here, never after. Throws std::invalid_argument for a size
-  // below 1 or a workspace of 2^31 cells or more.
-  GridPlanner(int max_width, int max_height, std::size_t max_path_cells);
+  // below 1, a side over 65535 cells or a workspace of 2^28 cells or more.
+  // open_entries sizes the open list (0: twice the workspace's cells). A
+  // search that fills it drops the entries it no longer needs (older
+  // entries of cells improved since) and goes on; the list never holds
+  // more than one needed entry per cell, so one larger than the grid
+  // never runs out. A smaller one (tests) can: kOpenListFull.
+  GridPlanner(int max_width, int max_height, std::size_t max_path_cells, std::size_t open_entries = 0);
   ~GridPlanner();
   GridPlanner(const GridPlanner&) = delete;
   GridPlanner& operator=(const GridPlanner&) = delete;
@@ -101,32 +123,42 @@ class GridPlanner {
   std::size_t max_path_cells() const noexcept { return max_path_; }
   // Bytes the workspace holds (for the docs' figures).
   std::size_t workspace_bytes() const noexcept;
+  // Times the last plan had to drop dead entries from a full open list.
+  std::size_t compactions() const noexcept { return compactions_; }
 
  private:
   struct Node;
-  struct OpenEntry;
+  struct Entry;
+  struct Compacted;
 
-  void make_tables(const PlannerParams& params) noexcept;
+  void make_tables(const PlannerParams& params, std::size_t cells) noexcept;
+  void next_stamp() noexcept;
   template <bool kAStar>
   bool search(const CostView& grid, GridCell start, GridCell goal, PlanResult& result) noexcept;
-  void next_stamp() noexcept;
-  void push(std::uint32_t cell, double g, double f) noexcept;
-  void sift_up(std::uint32_t slot, OpenEntry entry) noexcept;
-  OpenEntry pop() noexcept;
+  Compacted compact(std::uint32_t row, std::uint32_t stamp, std::uint32_t buckets, std::uint32_t free_list,
+                    std::uint32_t live) noexcept;
 
   int max_width_;
   int max_height_;
   std::size_t max_path_;
   std::size_t cells_;
-  std::unique_ptr<Node[]> nodes_;              // per cell: g, stamp, open-list slot
-  std::unique_ptr<std::uint8_t[]> parent_;     // per cell: the step that reached it (0..7)
-  std::unique_ptr<OpenEntry[]> open_;          // binary heap, at most one entry per cell
+  std::size_t pool_size_;
+  std::unique_ptr<Node[]> nodes_;           // per cell: g, stamp, its newest entry and step
+  std::unique_ptr<Entry[]> pool_;           // the open list's entries, linked in buckets
+  std::unique_ptr<std::uint32_t[]> head_;   // per bucket: its newest entry
   std::unique_ptr<GridCell[]> path_;
-  std::uint32_t open_size_ = 0;
   std::uint32_t stamp_ = 0;
-  // Per plan, indexed by cell cost: passable or not, the step factor.
+  std::size_t compactions_ = 0;
+  // Per plan: by cell cost, passable or not, the factor, the straight and
+  // diagonal steps in fixed point; the fixed point's fraction bits and the
+  // buckets' width (as a shift) and number (a power of two).
   bool passable_[256] = {};
   double factor_[256] = {};
+  std::int64_t straight_[256] = {};
+  std::int64_t diagonal_[256] = {};
+  int fraction_bits_ = 32;
+  int bucket_shift_ = 28;
+  std::uint32_t buckets_ = 16;
 };
 
 }  // namespace rtfuse::navigation

@@ -14,6 +14,7 @@ const char* to_string(PlanStatus status) noexcept {
     case PlanStatus::kGoalUnknown: return "goal unknown";
     case PlanStatus::kNoRoute: return "no route";
     case PlanStatus::kPathTooLong: return "path longer than the planner's buffer";
+    case PlanStatus::kOpenListFull: return "the planner's open list ran out";
   }
   return "unknown plan status";
 }

@@ -16,6 +16,7 @@ enum class PlanStatus : std::uint8_t {
   kGoalUnknown,        // the goal is unknown (255) and unknown is not passable
   kNoRoute,            // every cell reachable from the start was searched: the goal is not among them
   kPathTooLong,        // found, but longer than the planner's path buffer (cost and expansions still told)
+  kOpenListFull,       // only with an open list made smaller than the grid: it ran out
 };
 
 // A short English phrase ("goal in an obstacle"), never null.
