@@ -51,6 +51,10 @@ packages=(
   liboctomap-dev
   # OctoMap's scan.dat comes bzip2-compressed (tests/reference reads it)
   bzip2
+  # the grid planner's reference in the test build (tests/reference and its
+  # benchmark): Boost Graph's Dijkstra and A* on the same graph; header-only
+  # here, never linked into the runtime
+  libboost-graph-dev
 )
 
 missing=()
