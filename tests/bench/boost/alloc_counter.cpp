@@ -1,0 +1,1 @@
+#include "support/alloc_counter_impl.hpp"
