@@ -32,7 +32,7 @@
 // or above the goal's cost (every route still open costs at least that):
 // the cost is the optimum of the graph, to the fixed point's rounding. A
 // push or a pop is O(1) where a binary heap sifts through its levels
-// (docs/design.md, "Navigation: the grid planner", says what that was
+// (docs/design.md, "Navigation", "The grid planner", says what that was
 // worth). The reported cost is the path's own, in double: the factors of
 // its straight steps summed from the start, plus sqrt(2) times those of
 // its diagonal steps.
