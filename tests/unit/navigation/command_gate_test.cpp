@@ -1,7 +1,10 @@
 // The command gate: each stop an exact zero on the very step its condition
 // appears, the documented priority over every combination of conditions,
 // the acceleration limits and dt's fallbacks, acceleration from zero after
-// a stop, never backwards, the counts and names; no allocation.
+// a stop, never backwards, the counts and names; then the follower, the
+// clearance check and the gate on thousands of steps of garbage (NaN,
+// infinities, huge numbers, random paths and stamps), every output finite
+// and within the limits; no allocation.
 #include "navigation/command_gate.hpp"
 
 #include <gtest/gtest.h>
@@ -10,11 +13,14 @@
 #include <cstdint>
 #include <cstring>
 #include <limits>
+#include <random>
 #include <set>
 #include <stdexcept>
 #include <string>
 #include <vector>
 
+#include "navigation/path_clearance.hpp"
+#include "navigation/path_follower.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace command_gate_test {
@@ -292,6 +298,113 @@ TEST(CommandGate, ReasonsHaveTheirDiagnosticNames) {
   }
   EXPECT_EQ(distinct.size(), static_cast<std::size_t>(kStopReasonCount));
   EXPECT_STREQ(to_string(static_cast<StopReason>(99)), "unknown");
+}
+
+// Garbage for the property test: mostly sane values, some NaN, infinities,
+// huge and tiny numbers.
+struct Garbage {
+  std::mt19937_64 rng;
+  explicit Garbage(std::uint64_t seed) : rng(seed) {}
+  double unit() { return std::uniform_real_distribution<double>(0.0, 1.0)(rng); }
+  bool chance(double p) { return unit() < p; }
+  double value(double sane) {
+    switch (rng() % 16) {
+      case 0: return kNan;
+      case 1: return kInf;
+      case 2: return -kInf;
+      case 3: return (rng() % 2 ? 1.0 : -1.0) * std::pow(10.0, static_cast<double>(rng() % 600) - 300.0);
+      case 4: {  // any bit pattern
+        const std::uint64_t bits = rng();
+        double d;
+        std::memcpy(&d, &bits, sizeof d);
+        return d;
+      }
+      default: return (unit() * 2.0 - 1.0) * sane;
+    }
+  }
+};
+
+TEST(CommandGate, TheFollowerAndGateOnGarbageStayWithinTheLimits) {
+  const FollowerParams p;
+  PathFollower follower(p, 64);
+  CommandGate gate(p);
+  // A 2 m square costmap with a few obstacles, for path_blocked.
+  std::vector<std::uint8_t> cost(40 * 40, kCostFree);
+  for (int k = 0; k < 12; ++k) cost[static_cast<std::size_t>(k * 131 % 1600)] = kCostLethal;
+  const CostView costs{cost.data(), 40, 40};
+  const GridGeometry geometry{-1.0, -1.0, 0.05};
+  Garbage g(2028);
+  std::vector<Point2> path(80);
+  TimeNs now = 0, last_now = 0;
+  bool first = true;
+  Velocity2 last;
+  int driving = 0, stops = 0, paths = 0;
+  for (int step = 0; step < 6000; ++step) {
+    if (step % 50 == 0 || g.chance(0.01)) {
+      const int n = static_cast<int>(g.rng() % 80);  // over the capacity sometimes
+      const bool sane = g.chance(0.7);
+      for (int i = 0; i < n; ++i) path[i] = Point2{sane ? (g.unit() * 2 - 1) : g.value(5.0), sane ? (g.unit() * 2 - 1) : g.value(5.0)};
+      paths += follower.set_path(path.data(), n);
+    }
+    // Time: mostly a period on, sometimes garbage.
+    switch (g.rng() % 10) {
+      case 0: now = static_cast<TimeNs>(g.rng()); break;
+      case 1: now -= static_cast<TimeNs>(g.rng() % 1'000'000'000); break;
+      case 2: now += static_cast<TimeNs>(g.rng() % 400'000'000); break;
+      default: now += kPeriod;
+    }
+    const Pose2 pose{g.chance(0.8) ? g.unit() * 2 - 1 : g.value(3.0), g.chance(0.8) ? g.unit() * 2 - 1 : g.value(3.0),
+                     g.chance(0.8) ? g.unit() * 7 - 3.5 : g.value(10.0)};
+    const double speed = g.chance(0.7) ? last.linear : g.value(1.0);
+    const FollowResult r = follower.follow(pose, speed);
+    ASSERT_TRUE(std::isfinite(r.command.linear) && std::isfinite(r.command.angular)) << step;
+    ASSERT_TRUE(r.command.linear >= 0.0 && r.command.linear <= p.max_linear_mps) << step;
+    ASSERT_LE(std::fabs(r.command.angular), p.max_angular_rps) << step;
+    ASSERT_TRUE(std::isfinite(r.remaining_m) && std::isfinite(r.cross_track_m) && std::isfinite(r.curvature)) << step;
+    GateInput in = all_well(now);
+    in.enabled = g.chance(0.97);
+    in.stop_requested = g.chance(0.02);
+    in.estimate_finite = usable(pose);
+    in.estimate_stamp = g.chance(0.9) ? now - static_cast<TimeNs>(g.rng() % 600'000'000) : static_cast<TimeNs>(g.rng());
+    in.map_stamp = g.chance(0.95) ? now : static_cast<TimeNs>(g.rng() % 3);
+    in.have_goal = g.chance(0.98);
+    in.have_path = follower.has_path();
+    in.goal_reached = r.reached();
+    in.path_blocked = follower.has_path() &&
+                      path_blocked(costs, geometry, follower.path(), follower.path_size(), r.nearest_index, r.nearest,
+                                   g.chance(0.9) ? p.blocked_check_distance_m : g.value(100.0),
+                                   static_cast<std::uint8_t>(p.lethal_from));
+    const Velocity2 desired = g.chance(0.8) ? r.command : Velocity2{g.value(2.0), g.value(4.0)};
+    const GateOutput out = gate.step(in, desired);
+    const Velocity2 c = out.command;
+    ASSERT_TRUE(std::isfinite(c.linear) && std::isfinite(c.angular)) << step;
+    ASSERT_TRUE(c.linear >= 0.0 && c.linear <= p.max_linear_mps) << step << ": " << c.linear;
+    ASSERT_LE(std::fabs(c.angular), p.max_angular_rps) << step;
+    if (out.stopped()) {
+      ASSERT_EQ(c.linear, 0.0);
+      ASSERT_EQ(c.angular, 0.0);
+      ++stops;
+    } else {
+      // dt as the gate documents it, worked out here.
+      double dt = 0.05;
+      if (!first && now > last_now && static_cast<std::uint64_t>(now) - static_cast<std::uint64_t>(last_now) <=
+                                           static_cast<std::uint64_t>(2 * kPeriod)) {
+        dt = static_cast<double>(now - last_now) * 1e-9;
+      }
+      ASSERT_NEAR(out.dt_s, dt, 1e-15) << step;
+      ASSERT_LE(c.linear - last.linear, p.max_linear_accel_mps2 * dt + 1e-12) << step;
+      ASSERT_LE(last.linear - c.linear, p.max_linear_decel_mps2 * dt + 1e-12) << step;
+      ASSERT_LE(std::fabs(c.angular - last.angular), p.max_angular_accel_rps2 * dt + 1e-12) << step;
+      ++driving;
+    }
+    first = false;
+    last_now = now;
+    last = c;
+  }
+  // The garbage exercised both ways out.
+  EXPECT_GT(driving, 500);
+  EXPECT_GT(stops, 500);
+  EXPECT_GT(paths, 50);
 }
 
 TEST(CommandGate, SteppingAllocatesNothing) {
