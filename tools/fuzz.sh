@@ -33,7 +33,7 @@ while (($#)); do
     *) harnesses+=("$1"); shift ;;
   esac
 done
-all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss point_cloud map_server octomap_binary daemon_input)
+all=(config event_log hal_recording hal_record_codec sample_decoder canopen mpu zed_calibration kitti gnss point_cloud map_server octomap_binary daemon_input nav_command)
 ((${#harnesses[@]})) || harnesses=("${all[@]}")
 
 "$root/tools/setup-deps.sh"
@@ -113,6 +113,32 @@ for sel in range(4):
     open(f"{sys.argv[1]}/nmea{sel}", "wb").write(bytes([sel]) + epoch + nofix)
 open(f"{sys.argv[1]}/ubx", "wb").write(b"\x00" + frames)
 open(f"{sys.argv[1]}/mixed", "wb").write(b"\x03" + pvt(3, 1) + epoch + pvt(3, 1) + nofix)
+PY
+# The path follower and its gate (tests/fuzz/nav_command_fuzz.cpp has the
+# format): a drive along an L on a free map at 20 Hz, and one where the map
+# blocks the path, the stamps jump and the commands are NaN, infinite, huge.
+/usr/bin/python3 - "$seeds/nav_command" <<'PY'
+import struct, sys
+def small(v):  # even tag: int16 thousandths
+    return b"\x00" + struct.pack("<h", round(v * 1000))
+def raw(v):    # odd tag: the double's bytes
+    return b"\x01" + struct.pack("<d", v)
+def path(points):
+    return b"\x00" + bytes([len(points)]) + b"".join(small(x) + small(y) for x, y in points)
+def step(x, y, yaw, flags=0, advance=10, extra=b""):
+    return b"\x01" + small(x) + small(y) + small(yaw) + bytes([flags, advance, 0, 0]) + extra
+drive = b"\x00" + bytes(8) + path([(-1.5, -1.5), (1.0, -1.5), (1.0, 1.5)])
+drive += b"".join(step(-1.5 + 0.025 * k, -1.5, 0.0) for k in range(100))
+drive += b"".join(step(1.0, -1.5 + 0.025 * k, 1.57) for k in range(120))
+open(f"{sys.argv[1]}/drive", "wb").write(drive)
+rough = b"\x02" + bytes([0, 0, 0, 0x18, 0x18, 0, 0, 0]) + path([(-1.8, 0.1), (1.8, 0.1)])
+rough += b"".join(step(-1.8 + 0.01 * k, 0.1, 0.0) for k in range(30))
+rough += step(0.0, 0.1, 0.0, 0x10, 10, raw(float("nan")) + raw(1.0))
+rough += step(0.0, 0.1, 0.0, 0x18, 10, raw(1e308) + raw(float("inf")) + raw(-1e308))
+rough += b"\x01" + raw(float("nan")) + small(0.0) + small(0.0) + bytes([0x20]) + struct.pack("<q", 2**63 - 1) + bytes([0, 0])
+rough += b"\x00\x03" + raw(0.0) + raw(0.0) + raw(float("inf")) + raw(1.0) + raw(5e-324) + raw(1e300)
+rough += b"".join(step(-1.0, 0.1, 3.0, 0x80, 10, raw(-2.0) + raw(-2.0) + raw(5e-324)) for _ in range(3))
+open(f"{sys.argv[1]}/rough", "wb").write(rough)
 PY
 # The daemon's input path takes the decoders' messages, with their selector.
 cp "$seeds/sample_decoder"/* "$seeds/daemon_input/"
