@@ -22,6 +22,8 @@ namespace rtfuse {
 
 class FrameConsumer;
 class FrameSource;
+class GridConsumer;
+class GridSource;
 
 // How long one thread step waits for its device (an edge, a frame, bytes).
 // Live runs, lockstep drives and replays pass the same value, because a
@@ -64,6 +66,20 @@ class Device {
   // A device whose pairs others consume, and a consumer of them.
   virtual FrameSource* frame_source() noexcept { return nullptr; }
   virtual FrameConsumer* frame_consumer() noexcept { return nullptr; }
+  // A device whose 2-D grid others plan on (the mapper), and a consumer of it.
+  virtual GridSource* grid_source() noexcept { return nullptr; }
+  virtual GridConsumer* grid_consumer() noexcept { return nullptr; }
+  // LCM messages on the channels its descriptor's input_channels() names
+  // (channel is one of them), from whichever thread delivers them: the
+  // LCM thread live, the replay or the simulator's goal sequence in
+  // lockstep. Decoded there and handed to the loop through a ring; never
+  // blocks. `now` is the arrival time.
+  virtual void on_input(int channel, const std::uint8_t* data, int size, TimeNs now) noexcept {
+    (void)channel;
+    (void)data;
+    (void)size;
+    (void)now;
+  }
 };
 
 }  // namespace rtfuse

@@ -97,6 +97,12 @@ class DeviceDescriptor {
     (void)cfg;
   }
 
+  // LCM channels it takes messages from (Device::on_input gets the index).
+  virtual std::vector<std::string> input_channels(const RuntimeConfig& cfg) const {
+    (void)cfg;
+    return {};
+  }
+
   // --- buses -------------------------------------------------------------------
   // The kinds its driver cannot run without (bus_bit()s); others are optional.
   virtual std::uint32_t required_buses(const RuntimeConfig& cfg) const noexcept {

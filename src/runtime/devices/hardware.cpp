@@ -1,6 +1,7 @@
 #include "runtime/devices/hardware.hpp"
 
 #include "runtime/devices/frame_consumer.hpp"
+#include "runtime/devices/grid_consumer.hpp"
 #include "runtime/devices/device_layout.hpp"
 
 namespace rtfuse {
@@ -50,6 +51,14 @@ std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& co
         !ctx.host->frame_source()->attach(*device->frame_consumer(), error)) {
       return nullptr;
     }
+    if (ctx.host != nullptr && ctx.host->grid_source() != nullptr && device->grid_consumer() != nullptr &&
+        !ctx.host->grid_source()->attach(*device->grid_consumer(), error)) {
+      return nullptr;
+    }
+    const std::vector<std::string> channels = d.input_channels(cfg);
+    for (std::size_t k = 0; k < channels.size(); ++k) {
+      h->inputs_.push_back(Input{i, static_cast<int>(k), channels[k]});
+    }
     switch (d.scheduling()) {
       case DeviceScheduling::kPolled: h->polled_[h->num_polled_++] = i; break;
       case DeviceScheduling::kThread: h->threaded_[h->num_threaded_++] = i; break;
@@ -81,6 +90,19 @@ void Hardware::fill_snapshot(Snapshot& s) noexcept {
   for (const std::unique_ptr<Device>& d : devices_) {
     if (d) d->fill_snapshot(s);
   }
+}
+
+void Hardware::deliver_input(int i, const std::uint8_t* data, int size, TimeNs now) noexcept {
+  if (i < 0 || i >= input_count()) return;
+  const Input& in = inputs_[static_cast<std::size_t>(i)];
+  devices_[in.device]->on_input(in.index, data, size, now);
+}
+
+int Hardware::find_input(std::string_view channel) const noexcept {
+  for (std::size_t i = 0; i < inputs_.size(); ++i) {
+    if (inputs_[i].channel == channel) return static_cast<int>(i);
+  }
+  return -1;
 }
 
 void Hardware::step_workers() noexcept {

@@ -11,6 +11,7 @@
 #include <memory>
 #include <string>
 #include <string_view>
+#include <vector>
 
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/device_registry.hpp"
@@ -53,6 +54,14 @@ class Hardware final : public TickDevices {
   const char* worker_name(int i) const noexcept { return device_type(workers_[i]).name(); }
   void step_workers() noexcept;
   void finish_workers() noexcept;
+  // The LCM channels devices take input from (DeviceDescriptor::
+  // input_channels), in registry order: the live runtime subscribes to
+  // each and hands what arrives to deliver_input(i, ...) on its LCM thread.
+  int input_count() const noexcept { return static_cast<int>(inputs_.size()); }
+  const std::string& input_channel(int i) const noexcept { return inputs_[static_cast<std::size_t>(i)].channel; }
+  void deliver_input(int i, const std::uint8_t* data, int size, TimeNs now) noexcept;
+  // The input of that channel name, or -1.
+  int find_input(std::string_view channel) const noexcept;
   // The device of that registered name, as the type its descriptor makes;
   // null when the configuration has none (tools and tests).
   template <class T>
@@ -71,6 +80,12 @@ class Hardware final : public TickDevices {
   int num_threaded_ = 0;
   int workers_[kMaxDeviceTypes] = {};
   int num_workers_ = 0;
+  struct Input {
+    int device = 0;
+    int index = 0;  // among the device's own input channels
+    std::string channel;
+  };
+  std::vector<Input> inputs_;
   DeviceStatus layout_[kMaxDevices];  // names and ids, from describe_devices
   int slot_count_ = 0;
 };

@@ -47,7 +47,20 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
     *error = "cannot subscribe to the set_pose channel";
     return nullptr;
   }
+  if (Hardware* hw = rt->pipeline_->hardware()) {
+    for (int i = 0; i < hw->input_count(); ++i) {
+      if (!rt->lcm_->subscribe(hw->input_channel(i).c_str(), &Runtime::on_device_input, hw)) {
+        *error = "cannot subscribe to channel '" + hw->input_channel(i) + "'";
+        return nullptr;
+      }
+    }
+  }
   return rt;
+}
+
+void Runtime::on_device_input(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user) {
+  Hardware* hw = static_cast<Hardware*>(user);
+  hw->deliver_input(hw->find_input(channel), data, size, monotonic_now_ns());
 }
 
 Runtime::~Runtime() { stop(); }
@@ -206,8 +219,9 @@ void Runtime::input_thread() {
 
 void Runtime::worker_thread(int index) {
   Hardware& hw = *pipeline_->hardware();
-  char name[16];
+  char name[32];
   std::snprintf(name, sizeof name, "rtfuse-%s", hw.worker_name(index));
+  name[15] = '\0';  // the kernel's limit
   name_this_thread(name);
   // Below the default too: under load (a busy board, the CPU hog test) the
   // mapper falls behind and drops keyframes, counted, before anything else
@@ -219,8 +233,9 @@ void Runtime::worker_thread(int index) {
 
 void Runtime::device_thread(int index) {
   Device* device = &pipeline_->thread_device(index);
-  char name[16];
+  char name[32];
   std::snprintf(name, sizeof name, "rtfuse-%s", pipeline_->thread_device_name(index));
+  name[15] = '\0';  // the kernel's limit
   name_this_thread(name);
   // A step that finds nothing (a missing edge, no frame) is the device's to
   // count, not a reason to leave; the timeout bounds how long a stop waits.

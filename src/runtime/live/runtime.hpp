@@ -84,6 +84,8 @@ class Runtime {
   void device_thread(int index);
   void worker_thread(int index);
   static void on_lcm(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
+  // A device's input channel (the navigator's goals): to the device.
+  static void on_device_input(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user);
 
   std::unique_ptr<transport::LcmNode> lcm_;
   std::unique_ptr<MessageSink> lcm_sink_;

@@ -211,6 +211,8 @@ void MapperDevice::map_keyframe(const FramePool::Frame& f, const geometry::Rigid
     const double turned = last_mapped_.rotation.angularDistance(world_T_base.rotation);
     if (moved < config_.keyframe_distance_m && turned < config_.keyframe_angle_rad) {
       ++stats_.still;
+      // Nothing new to map, but the map is as current as this keyframe.
+      for (int i = 0; i < num_grid_consumers_; ++i) grid_consumers_[i]->on_map_current(f.stamp);
       return;
     }
   }
@@ -256,7 +258,32 @@ void MapperDevice::map_keyframe(const FramePool::Frame& f, const geometry::Rigid
     g.stamp = f.stamp;
     grids_.publish();
     ++s.grids;
+    for (int i = 0; i < num_grid_consumers_; ++i) grid_consumers_[i]->on_grid(cells, f.stamp);
   }
+  for (int i = 0; i < num_grid_consumers_; ++i) grid_consumers_[i]->on_map_current(f.stamp);
+}
+
+bool MapperDevice::attach(GridConsumer& consumer, std::string* error) {
+  if (grid_period_ns_ <= 0) {
+    *error = "[mapping] makes no grid (grid_rate = 0): nothing to plan on";
+    return false;
+  }
+  if (num_grid_consumers_ == kMaxGridConsumers) {
+    *error = "the mapper's grid has " + std::to_string(kMaxGridConsumers) + " consumers already";
+    return false;
+  }
+  grid_consumers_[num_grid_consumers_++] = &consumer;
+  return true;
+}
+
+GridLayout MapperDevice::grid_layout() const noexcept {
+  GridLayout g;
+  g.width = spec_.width;
+  g.height = spec_.height;
+  g.resolution_m = config_.resolution_m;
+  g.origin_x = mapping::grid_origin_x(mapper_->map().grid(), spec_);
+  g.origin_y = mapping::grid_origin_y(mapper_->map().grid(), spec_);
+  return g;
 }
 
 void MapperDevice::step(TimeNs timeout_ns) noexcept {

@@ -43,6 +43,7 @@
 #include "mapping/map_digest.hpp"
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/frame_consumer.hpp"
+#include "runtime/devices/grid_consumer.hpp"
 #include "runtime/fusion/fusion_core.hpp"
 
 namespace rtfuse {
@@ -98,7 +99,7 @@ struct Grid {
 };
 }  // namespace mapper_detail
 
-class MapperDevice final : public Device, public FrameConsumer {
+class MapperDevice final : public Device, public FrameConsumer, public GridSource {
  public:
   static constexpr int kQueueFrames = 2;
   static constexpr int kTrajectoryCapacity = 1 << 15;
@@ -116,6 +117,11 @@ class MapperDevice final : public Device, public FrameConsumer {
   void fill_snapshot(Snapshot& s) noexcept override;
   void publish_due(TimeNs now, transport::MessageSink& sink) noexcept override;
   FrameConsumer* frame_consumer() noexcept override { return this; }
+  GridSource* grid_source() noexcept override { return grid_period_ns_ > 0 ? this : nullptr; }
+  // GridSource: its consumers are called on the mapper's thread.
+  bool attach(GridConsumer& consumer, std::string* error) override;
+  GridLayout grid_layout() const noexcept override;
+
   // After every thread stopped: what is due by the last tick, then the
   // final grid. Live, replay and a lockstep drive end on the same map.
   void finish() noexcept override;
@@ -182,6 +188,10 @@ class MapperDevice final : public Device, public FrameConsumer {
   MapperStats stats_;
   SeqLock<MapperStats> health_;
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
+
+  static constexpr int kMaxGridConsumers = 2;
+  GridConsumer* grid_consumers_[kMaxGridConsumers] = {};
+  int num_grid_consumers_ = 0;
 
   // Mapper thread -> publisher thread.
   TripleBuffer<Grid> grids_;
