@@ -5,6 +5,7 @@
 
 #include "runtime/config/config.hpp"
 #include "runtime/fusion/device_status.hpp"
+#include "runtime/fusion/nav_snapshot.hpp"
 
 namespace rtfuse {
 
@@ -98,6 +99,7 @@ struct Snapshot {
   int num_devices = 0;
   DeviceStatus devices[kMaxDevices];
   WheelOdometrySnapshot wheel_odometry;
+  NavSnapshot nav;
 };
 
 }  // namespace rtfuse

@@ -8,12 +8,15 @@
 #include "geometry/rotation.hpp"
 #include "runtime/devices/device_layout.hpp"
 #include "runtime/devices/device_registry.hpp"
+#include "navigation/stop_reason.hpp"
 #include "rtfuse/diagnostics_t.hpp"
 #include "rtfuse/filter_state_t.hpp"
+#include "rtfuse/nav_status_t.hpp"
 #include "rtfuse/navsat_fix_t.hpp"
 #include "rtfuse/odometry_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/tf_t.hpp"
+#include "rtfuse/twist_stamped_t.hpp"
 #include "transport/encode_buffer.hpp"
 
 namespace rtfuse {
@@ -154,6 +157,9 @@ struct Publisher::Impl {
   Output<rtfuse::odometry_t> wheel_odometry;  // raw dead reckoning from the encoders
   std::int64_t last_wheel_stamp = -1;
   Name wheel_channel;
+  Output<rtfuse::twist_stamped_t> cmd_vel;
+  Output<rtfuse::nav_status_t> nav_status;
+  Name cmd_vel_channel, nav_status_channel;
   std::array<std::int64_t, kMaxSensors> rejections_at_last_diagnostics{};
   std::int64_t encode_failures = 0;
 };
@@ -266,6 +272,24 @@ Publisher::Publisher(const RuntimeConfig& c) : impl_(std::make_unique<Impl>(c)) 
   // way robot_localization users read it, a huge variance.
   for (int i = 0; i < 6; ++i) m.wheel_odometry.msg.pose.covariance[i * 7] = 1e6;
   m.wheel_odometry.finalize();
+
+  const NavigationSection& nav = c.hardware.navigation;
+  m.cmd_vel_channel = nav.cmd_vel_channel;
+  m.nav_status_channel = nav.status_channel;
+  m.cmd_vel.channel = m.cmd_vel_channel.c_str();
+  m.cmd_vel.msg.header.frame_id = base;
+  m.cmd_vel.finalize();
+  m.nav_status.channel = m.nav_status_channel.c_str();
+  m.nav_status.msg.header.frame_id = c.world_frame.c_str();
+  // Room for the longest texts, so assigning them never allocates.
+  auto& st = m.nav_status.msg;
+  st.goal_state.assign(16, ' ');
+  st.goal_error.assign(sizeof(NavSnapshot::goal_error), ' ');
+  st.stop_reason.assign(24, ' ');
+  m.nav_status.finalize();
+  st.goal_state = "none";
+  st.goal_error.clear();
+  st.stop_reason = "no_goal";
 }
 
 Publisher::~Publisher() = default;
@@ -370,6 +394,7 @@ std::uint32_t Publisher::schedule(const Snapshot& s, TimeNs now) noexcept {
     due |= kWheelOdometry;
   }
   if (m.diagnostics.schedule.due(now)) due |= kDiagnostics;
+  if (s.nav.active && s.nav.command_due) due |= kNavigation;
   return due;
 }
 
@@ -383,7 +408,8 @@ int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, Message
   // The estimate's own time, not the publishing time: consumers interpolate
   // and look up transforms by it, as they would with robot_localization.
   for (int k = 0; k < m.num_instances; ++k) {
-    const std::uint32_t bits = (due >> (k * kInstanceShift)) & 0xffu & ~(kWheelOdometry | kDiagnostics);
+    const std::uint32_t bits =
+        (due >> (k * kInstanceShift)) & 0xffu & ~(kWheelOdometry | kDiagnostics | kNavigation);
     if (bits != 0) sent += m.publish_instance(s, k, bits, now, sink);
   }
 
@@ -401,6 +427,41 @@ int Publisher::publish(const Snapshot& s, std::uint32_t due, TimeNs now, Message
     o.twist.covariance[0] = w.var_vx;
     o.twist.covariance[35] = w.var_vyaw;
     sent += m.emit(m.wheel_odometry, now, sink);
+  }
+
+  if (due & kNavigation) {
+    const NavSnapshot& n = s.nav;
+    // Commands and status are stamped with the tick that computed them: a
+    // base compares it with its clock to refuse a late command.
+    const std::int64_t utime = ns_to_utime(s.tick_time_ns);
+    if (n.send_command) {
+      auto& c = m.cmd_vel.msg;
+      c.header.utime = utime;
+      c.header.seq = m.cmd_vel.next_seq();
+      c.twist.linear.x = n.linear_mps;
+      c.twist.angular.z = n.angular_rps;
+      sent += m.emit(m.cmd_vel, now, sink);
+    }
+    auto& st = m.nav_status.msg;
+    st.header.utime = utime;
+    st.header.seq = m.nav_status.next_seq();
+    st.goal_seq = n.goal_seq;
+    st.goal_x = n.goal_x;
+    st.goal_y = n.goal_y;
+    st.goal_state.assign(to_string(n.goal_state));
+    st.goal_error.assign(n.goal_error);
+    st.linear_mps = n.linear_mps;
+    st.angular_rps = n.angular_rps;
+    st.stop_reason.assign(navigation::to_string(static_cast<navigation::StopReason>(n.stop_reason)));
+    st.plan_seq = n.plan_seq;
+    st.path_points = n.path_points;
+    st.remaining_m = n.remaining_m;
+    st.cross_track_m = n.cross_track_m;
+    st.plans = n.plans;
+    st.plan_failures = n.plan_failures;
+    st.replans_blocked = n.replans_blocked;
+    st.replans_off_path = n.replans_off_path;
+    sent += m.emit(m.nav_status, now, sink);
   }
 
   if (due & kDiagnostics) {

@@ -35,10 +35,13 @@ class Publisher {
     kWheelOdometry = 1u << 4,
     kDiagnostics = 1u << 5,
     kFilteredFix = 1u << 6,
+    // The navigator's status and, when it sends one, its command
+    // (Snapshot::nav), on the ticks it computed them.
+    kNavigation = 1u << 7,
   };
   // Instance k's outputs (odometry, pose, tf, state, filtered fix) are the
-  // first instance's bits shifted by k * kInstanceShift; wheel odometry and
-  // diagnostics are the process's, at their own bits.
+  // first instance's bits shifted by k * kInstanceShift; wheel odometry,
+  // diagnostics and navigation are the process's, at their own bits.
   static constexpr int kInstanceShift = 8;
   static_assert(kMaxInstances * kInstanceShift <= 32, "the due mask is 32 bits");
   // Which outputs are due at `now` for this snapshot (all of them on the
