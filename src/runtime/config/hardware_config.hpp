@@ -11,6 +11,7 @@
 #include "runtime/devices/gnss/gnss_section.hpp"
 #include "runtime/devices/imu/mpu_section.hpp"
 #include "runtime/devices/mapper/mapping_section.hpp"
+#include "runtime/devices/navigator/navigation_section.hpp"
 #include "runtime/devices/visual_odometry/vo_section.hpp"
 #include "runtime/devices/wheel_encoders/wheel_encoders_section.hpp"
 
@@ -41,6 +42,7 @@ struct HardwareConfig {
   VoSection vo;
   GnssSection gnss;
   MappingSection mapping;
+  NavigationSection navigation;
   // Per device source (device_source(id)): the [[sensor]] it feeds, -1 none.
   std::array<int, kMaxDeviceSources> source_sensor = no_source_sensors();
 };

@@ -4,6 +4,7 @@
 #include "runtime/devices/gnss/gnss_descriptor.hpp"
 #include "runtime/devices/imu/imu_descriptor.hpp"
 #include "runtime/devices/mapper/mapper_descriptor.hpp"
+#include "runtime/devices/navigator/navigator_descriptor.hpp"
 #include "runtime/devices/visual_odometry/visual_odometry_descriptor.hpp"
 #include "runtime/devices/wheel_encoders/wheel_encoders_descriptor.hpp"
 
@@ -18,6 +19,7 @@ const DeviceDescriptor* const kDevices[] = {
     &visual_odometry_descriptor(),
     &gnss_descriptor(),
     &mapper_descriptor(),
+    &navigator_descriptor(),
 };
 constexpr int kDeviceCount = static_cast<int>(sizeof(kDevices) / sizeof(kDevices[0]));
 static_assert(kDeviceCount <= kMaxDeviceTypes, "raise kMaxDeviceTypes");
