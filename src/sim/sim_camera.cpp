@@ -8,9 +8,9 @@
 
 namespace rtfuse::sim {
 
-std::unique_ptr<SimCamera> SimCamera::create(const RuntimeConfig& cfg, const TruthTrajectory& truth,
-                                             hal::Clock& clock, TimeNs t0, std::uint64_t seed,
-                                             const std::vector<ObstacleBox>& obstacles, std::string* error) {
+std::unique_ptr<SimCamera> SimCamera::create(const RuntimeConfig& cfg, TruthSource& truth, hal::Clock& clock,
+                                             TimeNs t0, std::uint64_t seed, const std::vector<ObstacleBox>& obstacles,
+                                             std::string* error) {
   const CameraSection& c = cfg.hardware.camera;
   drivers::CameraMode mode;
   if (!drivers::find_camera_mode(c.resolution.view(), c.fps, &mode, error)) return nullptr;

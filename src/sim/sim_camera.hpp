@@ -18,7 +18,7 @@
 #include "sim/camera_world.hpp"
 #include "sim/sim_device.hpp"
 #include "sim/stereo_renderer.hpp"
-#include "sim/truth_trajectory.hpp"
+#include "sim/truth_source.hpp"
 
 namespace rtfuse::sim {
 
@@ -29,9 +29,10 @@ std::unique_ptr<SimDevice> make_sim_camera(const SimDeviceContext& ctx, std::str
 class SimCamera final : public hal::mock::FrameGenerator, public SimDevice {
  public:
   // The camera section's calibration file and mode, the mount from the
-  // config's static transforms, the scenario's obstacles in its world.
-  // Null with *error when they do not fit.
-  static std::unique_ptr<SimCamera> create(const RuntimeConfig& cfg, const TruthTrajectory& truth, hal::Clock& clock,
+  // config's static transforms, the scenario's obstacles in its world;
+  // `truth` is read on the camera's thread. Null with *error when they do
+  // not fit.
+  static std::unique_ptr<SimCamera> create(const RuntimeConfig& cfg, TruthSource& truth, hal::Clock& clock,
                                            TimeNs t0, std::uint64_t seed, const std::vector<ObstacleBox>& obstacles,
                                            std::string* error);
 
@@ -53,7 +54,7 @@ class SimCamera final : public hal::mock::FrameGenerator, public SimDevice {
  private:
   SimCamera() = default;
 
-  const TruthTrajectory* truth_ = nullptr;
+  TruthSource* truth_ = nullptr;
   TimeNs t0_ = 0;
   TimeNs period_ = 0;
   TimeNs next_ = 0;

@@ -13,7 +13,7 @@
 #include "runtime/config/config.hpp"
 #include "runtime/devices/device_buses.hpp"
 #include "sim/drive_scenario.hpp"
-#include "sim/truth_trajectory.hpp"
+#include "sim/truth_source.hpp"
 
 namespace rtfuse::sim {
 
@@ -22,7 +22,9 @@ struct SimDeviceContext {
   const RuntimeConfig& cfg;
   const DriveScenario& scenario;
   const std::string& scenario_path;  // in messages
-  const TruthTrajectory& truth;
+  // This device's own: a commanded robot's truth advances per reader, and
+  // each device reads it on its driver's thread.
+  TruthSource& truth;
   hal::Clock& clock;
   TimeNs t0;
 };

@@ -28,8 +28,7 @@ std::int64_t wrap_position(std::int64_t counts, int bits, bool is_signed) noexce
   return static_cast<std::int64_t>(raw);
 }
 
-SimEncoders::SimEncoders(const DriveScenario& scenario, const TruthTrajectory& truth, const hal::Clock& clock,
-                         TimeNs t0)
+SimEncoders::SimEncoders(const DriveScenario& scenario, TruthSource& truth, const hal::Clock& clock, TimeNs t0)
     : truth_(truth),
       clock_(clock),
       t0_(t0),

@@ -20,7 +20,7 @@
 #include "sim/devices/canopen_encoder_node.hpp"
 #include "hal/mock/mock_can_bus.hpp"
 #include "sim/drive_scenario.hpp"
-#include "sim/truth_trajectory.hpp"
+#include "sim/truth_source.hpp"
 #include "sim/sim_device.hpp"
 
 namespace rtfuse::sim {
@@ -39,8 +39,9 @@ std::int64_t wrap_position(std::int64_t counts, int bits, bool is_signed) noexce
 
 class SimEncoders final : public hal::CanBus, public SimDevice {
  public:
-  // `truth` and `clock` must outlive this.
-  SimEncoders(const DriveScenario& scenario, const TruthTrajectory& truth, const hal::Clock& clock, TimeNs t0);
+  // `truth` and `clock` must outlive this; `truth` is read on the thread
+  // that sends and receives (the loop).
+  SimEncoders(const DriveScenario& scenario, TruthSource& truth, const hal::Clock& clock, TimeNs t0);
   ~SimEncoders() override;
   SimEncoders(const SimEncoders&) = delete;
   SimEncoders& operator=(const SimEncoders&) = delete;
@@ -84,7 +85,7 @@ class SimEncoders final : public hal::CanBus, public SimDevice {
     bool begins = false;
   };
 
-  const TruthTrajectory& truth_;
+  TruthSource& truth_;
   const hal::Clock& clock_;
   TimeNs t0_;
   RobotBody robot_;

@@ -19,7 +19,7 @@ constexpr int kFrame = kPayload + 8;
 
 }  // namespace
 
-SimGnss::SimGnss(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0)
+SimGnss::SimGnss(const DriveScenario& scenario, TruthSource& truth, hal::Clock& clock, TimeNs t0)
     : cfg_(scenario.gnss),
       truth_(truth),
       clock_(clock),

@@ -22,7 +22,7 @@
 #include "hal/mock/mock_serial_port.hpp"
 #include "sim/drive_scenario.hpp"
 #include "sim/sim_device.hpp"
-#include "sim/truth_trajectory.hpp"
+#include "sim/truth_source.hpp"
 
 namespace rtfuse::sim {
 
@@ -42,7 +42,8 @@ struct SimGnssEpoch {
 
 class SimGnss final : public hal::SerialPort, public SimDevice {
  public:
-  SimGnss(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0);
+  // `truth` and `clock` must outlive this; `truth` is read on the GNSS thread.
+  SimGnss(const DriveScenario& scenario, TruthSource& truth, hal::Clock& clock, TimeNs t0);
 
   // When the next epoch's bytes start to arrive.
   TimeNs next_arrival() const noexcept;
@@ -68,7 +69,7 @@ class SimGnss final : public hal::SerialPort, public SimDevice {
   bool in_outage(double t_s) const noexcept;
 
   const SimGnssConfig cfg_;
-  const TruthTrajectory& truth_;
+  TruthSource& truth_;
   hal::Clock& clock_;
   TimeNs t0_;
   std::uint64_t seed_;

@@ -21,7 +21,7 @@ int accel_fs_sel(int g) noexcept { return g == 2 ? 0 : g == 4 ? 1 : g == 8 ? 2 :
 
 }  // namespace
 
-SimImu::SimImu(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0)
+SimImu::SimImu(const DriveScenario& scenario, TruthSource& truth, hal::Clock& clock, TimeNs t0)
     : truth_(truth),
       clock_(clock),
       t0_(t0),

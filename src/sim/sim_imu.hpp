@@ -27,7 +27,7 @@
 #include "hal/mock/mock_i2c_bus.hpp"
 #include "sim/devices/mpu_register_file.hpp"
 #include "sim/drive_scenario.hpp"
-#include "sim/truth_trajectory.hpp"
+#include "sim/truth_source.hpp"
 #include "sim/sim_device.hpp"
 
 namespace rtfuse::sim {
@@ -45,8 +45,8 @@ struct ImuChipReading {
 
 class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimDevice {
  public:
-  // `truth` and `clock` must outlive this.
-  SimImu(const DriveScenario& scenario, const TruthTrajectory& truth, hal::Clock& clock, TimeNs t0);
+  // `truth` and `clock` must outlive this; `truth` is read on the IMU thread.
+  SimImu(const DriveScenario& scenario, TruthSource& truth, hal::Clock& clock, TimeNs t0);
   ~SimImu() override;
   SimImu(const SimImu&) = delete;
   SimImu& operator=(const SimImu&) = delete;
@@ -102,7 +102,7 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimD
  private:
   std::int64_t first_sample_at_or_after(TimeNs t) const noexcept;
 
-  const TruthTrajectory& truth_;
+  TruthSource& truth_;
   hal::Clock& clock_;
   TimeNs t0_;
   SimImuConfig cfg_;

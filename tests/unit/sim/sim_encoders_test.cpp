@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "hal/mock/sim_clock.hpp"
+#include "sim/truth_trajectory.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
@@ -90,7 +91,7 @@ std::int64_t expected_counts(const DriveScenario& sc, const TruthState& s, int w
 
 TEST(SimEncoders, NodesBootAndAnswerSyncWithTheTruthAtTheSyncTime) {
   const DriveScenario sc = straight_drive();
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimEncoders bus(sc, truth, clock, kT0);
   auto frames = drain(bus);
@@ -136,7 +137,7 @@ TEST(SimEncoders, DropoutSilencesTheNodeThenItBootsLikeAPowerCycledNode) {
   DriveScenario sc = straight_drive();
   sc.dropout_count = 1;
   sc.dropouts[0] = EncoderDropout{2, 2.0, 2.0};
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimEncoders bus(sc, truth, clock, kT0);
   drain(bus);
@@ -189,7 +190,7 @@ TEST(SimEncoders, SlipEpisodeAddsItsFractionToTheCounts) {
   sc.robot.wheels[0].radius_error = 0.0;
   sc.slip.episode_count = 1;
   sc.slip.episodes[0] = SlipEpisode{5.0, 3.0, 0x01, 0.3};  // left wheel, at cruise
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimEncoders bus(sc, truth, clock, kT0);
   ASSERT_EQ(bus.send(nmt_start_all()), HalStatus::kOk);
@@ -223,7 +224,7 @@ TEST(SimEncoders, NarrowAndSignedEncodersWrapAndInvertedSidesCountDown) {
   sc.robot.encoder_bits = 12;
   sc.robot.encoder_signed = true;
   sc.robot.invert_right = true;
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimEncoders bus(sc, truth, clock, kT0);
   ASSERT_EQ(bus.send(nmt_start_all()), HalStatus::kOk);
@@ -262,8 +263,8 @@ TEST(SimEncoders, SameScenarioSameFramesAndNoAllocationPerCall) {
   sc.slip.noise_fraction = 0.02;
   sc.dropout_count = 1;
   sc.dropouts[0] = EncoderDropout{1, 3.0, 1.0};
-  const TruthTrajectory truth_a(sc);
-  const TruthTrajectory truth_b(sc);
+  TruthTrajectory truth_a(sc);
+  TruthTrajectory truth_b(sc);
   SimClock clock_a(kT0), clock_b(kT0);
   SimEncoders a(sc, truth_a, clock_a, kT0);
   SimEncoders b(sc, truth_b, clock_b, kT0);

@@ -11,6 +11,7 @@
 
 #include "drivers/gnss/gnss_receiver.hpp"
 #include "hal/mock/sim_clock.hpp"
+#include "sim/truth_trajectory.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {

@@ -11,6 +11,7 @@
 
 #include "geometry/rotation.hpp"
 #include "hal/mock/sim_clock.hpp"
+#include "sim/truth_trajectory.hpp"
 #include "support/alloc_counter.hpp"
 
 namespace rtfuse::sim {
@@ -84,7 +85,7 @@ Decoded burst_read(SimImu& imu, sim::MpuChip model = sim::MpuChip::kMpu6050) {
 
 TEST(SimImu, EdgesComeAtTheRateAndTheWaitMovesTheClock) {
   const DriveScenario sc = turning_drive();
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimImu imu(sc, truth, clock, kT0);
   configure(imu);
@@ -110,7 +111,7 @@ TEST(SimImu, EdgesComeAtTheRateAndTheWaitMovesTheClock) {
 
 TEST(SimImu, ASleepingChipOrOneWithoutDataReadyRaisesNoEdge) {
   const DriveScenario sc = turning_drive();
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimImu imu(sc, truth, clock, kT0);
   GpioEdge e;
@@ -130,7 +131,7 @@ TEST(SimImu, RegistersHoldGravityAndTheTrueMotionThroughTheMounting) {
   sc.imu.xyz_m = {0.3, -0.2, 0.1};
   sc.imu.rpy_rad = {kPi, 0.0, 0.5 * kPi};  // upside down, turned left
   sc.imu.temperature_c = 41.0;
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimImu imu(sc, truth, clock, kT0);
   configure(imu);
@@ -176,7 +177,7 @@ TEST(SimImu, NoiseHasTheDensityTimesRootHalfTheRateAndTheBiasAsMean) {
   sc.imu.accel_noise_density = 400e-6 * kG;
   sc.imu.gyro_bias_rad_s = {0.01, -0.02, 0.005};
   sc.imu.accel_bias_mps2 = {0.1, 0.0, -0.05};
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimImu imu(sc, truth, clock, kT0);
   configure(imu);
@@ -222,8 +223,8 @@ TEST(SimImu, SameSeedSameBytesWhateverTheCallPattern) {
   sc.seed = 1234;
   sc.imu.gyro_noise_density = 0.005 * kDeg;
   sc.imu.accel_noise_density = 400e-6 * kG;
-  const TruthTrajectory truth_a(sc);
-  const TruthTrajectory truth_b(sc);
+  TruthTrajectory truth_a(sc);
+  TruthTrajectory truth_b(sc);
   SimClock clock_a(kT0), clock_b(kT0);
   SimImu a(sc, truth_a, clock_a, kT0);
   SimImu b(sc, truth_b, clock_b, kT0);
@@ -274,7 +275,7 @@ TEST(SimImu, SameSeedSameBytesWhateverTheCallPattern) {
 TEST(SimImu, WaitAndBurstReadDoNotAllocate) {
   DriveScenario sc = turning_drive();
   sc.imu.gyro_noise_density = 0.005 * kDeg;
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimImu imu(sc, truth, clock, kT0);
   configure(imu);
@@ -297,7 +298,7 @@ TEST(SimImu, ModelAndAddressComeFromTheScenario) {
   DriveScenario sc = turning_drive();
   sc.imu.model = MpuChip::kMpu9250;
   sc.imu.address = 0x69;
-  const TruthTrajectory truth(sc);
+  TruthTrajectory truth(sc);
   SimClock clock(kT0);
   SimImu imu(sc, truth, clock, kT0);
   std::uint8_t who = 0;
