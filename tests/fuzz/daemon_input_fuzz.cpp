@@ -5,10 +5,12 @@
 // three of them again (shared inputs, map -> odom) and set_pose accepted. Each input is one
 // message, published on memq:// to the daemon's own LCM node while it runs:
 // the first byte picks the channel (odometry, pose, twist, IMU, set_pose,
-// navsat fix, as in sample_decoder_fuzz.cpp, whose seeds serve here), the
-// rest is the bytes.
+// navsat fix, as in sample_decoder_fuzz.cpp, whose seeds serve here; then
+// the navigator's goal and stop), the rest is the bytes. The navigator runs
+// with follow = true on the mapper's grid.
 // Property: no crash or sanitizer report in any thread, every published
-// odometry and pose finite, and the daemon still publishing at the end.
+// odometry and pose finite, every velocity command finite and within the
+// configured limits, and the daemon still publishing at the end.
 #include <atomic>
 #include <chrono>
 #include <cmath>
@@ -23,6 +25,7 @@
 #include "fuzz_check.hpp"
 #include "hal/linux/monotonic_clock.hpp"
 #include "rtfuse/odometry_t.hpp"
+#include "rtfuse/twist_stamped_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "runtime/devices/camera/camera_calibration.hpp"
 #include "runtime/config/config_loader.hpp"
@@ -32,7 +35,7 @@
 namespace {
 
 constexpr const char* kChannels[] = {"fuzz/odometry", "fuzz/pose", "fuzz/twist", "fuzz/imu", "rtfuse/set_pose",
-                                     "fuzz/navsat"};
+                                     "fuzz/navsat", "rtfuse/goal", "rtfuse/stop"};
 constexpr int kNumChannels = sizeof(kChannels) / sizeof(kChannels[0]);
 
 // Every kind of LCM sensor, each fusing what its type provides.
@@ -104,6 +107,7 @@ struct Daemon {
   std::unique_ptr<rtfuse::Runtime> runtime;
   std::atomic<std::int64_t> handled{0};  // input messages the LCM thread has dispatched
   std::atomic<std::int64_t> outputs{0};  // odometry and pose messages checked
+  std::atomic<std::int64_t> commands{0};  // velocity commands checked
   std::int64_t published = 0;
 };
 
@@ -141,6 +145,19 @@ void check_pose(const char*, const std::uint8_t* data, int size, std::int64_t, v
   static_cast<Daemon*>(user)->outputs.fetch_add(1, std::memory_order_relaxed);
 }
 
+void check_cmd_vel(const char*, const std::uint8_t* data, int size, std::int64_t, void* user) {
+  rtfuse::twist_stamped_t m;
+  FUZZ_CHECK(m.decode(data, 0, size) == size, "the daemon's command decodes");
+  const auto& f = static_cast<Daemon*>(user)->cfg.hardware.navigation.follower;
+  const auto& t = m.twist;
+  FUZZ_CHECK(std::isfinite(t.linear.x) && std::isfinite(t.angular.z), "no NaN or infinity in a command");
+  FUZZ_CHECK(t.linear.x >= 0.0 && t.linear.x <= f.max_linear_mps, "the linear command within [0, max_linear]");
+  FUZZ_CHECK(std::fabs(t.angular.z) <= f.max_angular_rps, "the angular command within max_angular");
+  FUZZ_CHECK(t.linear.y == 0.0 && t.linear.z == 0.0 && t.angular.x == 0.0 && t.angular.y == 0.0,
+             "a planar command");
+  static_cast<Daemon*>(user)->commands.fetch_add(1, std::memory_order_relaxed);
+}
+
 [[noreturn]] void fail(const std::string& why) {
   std::fprintf(stderr, "daemon_input_fuzz: %s\n", why.c_str());
   std::abort();
@@ -155,10 +172,11 @@ void report() {
   const rtfuse::Snapshot s = d.runtime->latest();
   std::fprintf(stderr,
                "daemon_input_fuzz: %lld messages published, %lld outputs checked, %lld ticks, %lld overruns, "
-               "set_pose %lld applied %lld rejected\n",
+               "set_pose %lld applied %lld rejected, %lld commands checked\n",
                static_cast<long long>(d.published), static_cast<long long>(after),
                static_cast<long long>(s.loop.ticks), static_cast<long long>(s.loop.overruns),
-               static_cast<long long>(s.set_pose_count), static_cast<long long>(s.set_pose_rejected));
+               static_cast<long long>(s.set_pose_count), static_cast<long long>(s.set_pose_rejected),
+               static_cast<long long>(d.commands.load()));
   for (int i = 0; i < s.num_sensors; ++i) {
     const rtfuse::SensorStats& st = s.sensors[i];
     std::fprintf(stderr,
@@ -190,6 +208,7 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   text.replace(at, off.size(), "accept_set_pose = true");
   text += kFuzzSensors;
   text += kGlobalInstance;
+  text += "\n[navigation]\nfollow = true\n";
   rtfuse::ConfigLoadResult loaded = rtfuse::load_config_string(text, path);
   if (!loaded.config) fail(loaded.errors.empty() ? "config" : loaded.errors.front().to_string());
   g_daemon = new Daemon;
@@ -209,7 +228,8 @@ extern "C" int LLVMFuzzerInitialize(int*, char***) {
   if (!d.runtime->lcm().subscribe(cfg.publish.odometry_channel.c_str(), check_odometry, &d) ||
       !d.runtime->lcm().subscribe(cfg.publish.pose_channel.c_str(), check_pose, &d) ||
       !d.runtime->lcm().subscribe(cfg.instances[1].odometry_channel.c_str(), check_odometry, &d) ||
-      !d.runtime->lcm().subscribe(cfg.instances[1].pose_channel.c_str(), check_pose, &d)) {
+      !d.runtime->lcm().subscribe(cfg.instances[1].pose_channel.c_str(), check_pose, &d) ||
+      !d.runtime->lcm().subscribe(cfg.hardware.navigation.cmd_vel_channel.c_str(), check_cmd_vel, &d)) {
     fail("subscribe");
   }
   std::string warnings;

@@ -18,7 +18,9 @@
 
 #include "rtfuse/imu_t.hpp"
 #include "rtfuse/navsat_fix_t.hpp"
+#include "rtfuse/nav_stop_t.hpp"
 #include "rtfuse/odometry_t.hpp"
+#include "rtfuse/pose_stamped_t.hpp"
 #include "rtfuse/pose_with_covariance_stamped_t.hpp"
 #include "rtfuse/twist_with_covariance_stamped_t.hpp"
 #include "runtime/replay/hal_recording.hpp"
@@ -109,6 +111,21 @@ int main(int argc, char** argv) {
   // shares these seeds) starts with a set_pose the filter applies.
   pose.header.frame_id = "odom";
   write_file(dir + "/sample_decoder/set_pose_odom", encode(pose), 4, true);
+  // The navigator's inputs, daemon_input_fuzz's selectors 6 and 7: a goal
+  // 2 m ahead in the map's frame, a stop and its release.
+  rtfuse::pose_stamped_t goal{};
+  goal.header = odom.header;
+  goal.pose.position.x = 2.0;
+  goal.pose.orientation.w = 1.0;
+  write_file(dir + "/daemon_input/goal", encode(goal), 6, true);
+  rtfuse::nav_stop_t stop{};
+  stop.header = odom.header;
+  stop.header.frame_id = "base_link";
+  stop.stop = true;
+  stop.reason = "operator";
+  write_file(dir + "/daemon_input/stop", encode(stop), 7, true);
+  stop.stop = false;
+  write_file(dir + "/daemon_input/release", encode(stop), 7, true);
 
   // --- a HAL recording ---------------------------------------------------
   // The device table of hal_record_codec_fuzz.cpp, so each record seeds it too.
