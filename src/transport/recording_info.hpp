@@ -24,13 +24,16 @@ namespace rtfuse::transport {
 
 // Bump when a rtfuse/hal/* or rtfuse/rec/* record changes meaning or layout.
 // 3: a recording ends with its rtfuse/rec/end record.
-constexpr std::int32_t kHalRecordFormatVersion = 3;
+// 4: devices' LCM inputs (the navigator's goals) on rtfuse/rec/in/<channel>,
+//    and how many of each the loop had taken after the sensors in a tick.
+constexpr std::int32_t kHalRecordFormatVersion = 4;
 
 constexpr std::string_view kRecordingInfoChannel = "rtfuse/rec/info";
 constexpr std::string_view kLoopTickChannel = "rtfuse/rec/tick";
 constexpr std::string_view kRecordedFileChannel = "rtfuse/rec/file";
 constexpr std::string_view kRecordingEndChannel = "rtfuse/rec/end";
 constexpr std::string_view kRecordChannelPrefix = "rtfuse/rec/";
+constexpr std::string_view kRecordedInputPrefix = "rtfuse/rec/in/";
 constexpr std::string_view kHalChannelPrefix = "rtfuse/hal/";
 
 constexpr int kMaxRecordedDevices = 64;

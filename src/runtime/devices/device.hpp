@@ -80,6 +80,12 @@ class Device {
     (void)size;
     (void)now;
   }
+  // Loop thread: the messages of that input channel the loop has taken so
+  // far (a recording's tick keeps it, so a replay delivers them in time).
+  virtual std::int64_t inputs_taken(int channel) const noexcept {
+    (void)channel;
+    return 0;
+  }
 };
 
 }  // namespace rtfuse

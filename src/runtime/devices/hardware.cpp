@@ -98,6 +98,12 @@ void Hardware::deliver_input(int i, const std::uint8_t* data, int size, TimeNs n
   devices_[in.device]->on_input(in.index, data, size, now);
 }
 
+std::int64_t Hardware::input_taken(int i) const noexcept {
+  if (i < 0 || i >= input_count()) return 0;
+  const Input& in = inputs_[static_cast<std::size_t>(i)];
+  return devices_[in.device]->inputs_taken(in.index);
+}
+
 int Hardware::find_input(std::string_view channel) const noexcept {
   for (std::size_t i = 0; i < inputs_.size(); ++i) {
     if (inputs_[i].channel == channel) return static_cast<int>(i);

@@ -60,6 +60,7 @@ class Hardware final : public TickDevices {
   int input_count() const noexcept { return static_cast<int>(inputs_.size()); }
   const std::string& input_channel(int i) const noexcept { return inputs_[static_cast<std::size_t>(i)].channel; }
   void deliver_input(int i, const std::uint8_t* data, int size, TimeNs now) noexcept;
+  std::int64_t input_taken(int i) const noexcept;
   // The input of that channel name, or -1.
   int find_input(std::string_view channel) const noexcept;
   // The device of that registered name, as the type its descriptor makes;

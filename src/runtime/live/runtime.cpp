@@ -49,7 +49,7 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
   }
   if (Hardware* hw = rt->pipeline_->hardware()) {
     for (int i = 0; i < hw->input_count(); ++i) {
-      if (!rt->lcm_->subscribe(hw->input_channel(i).c_str(), &Runtime::on_device_input, hw)) {
+      if (!rt->lcm_->subscribe(hw->input_channel(i).c_str(), &Runtime::on_device_input, rt->pipeline_.get())) {
         *error = "cannot subscribe to channel '" + hw->input_channel(i) + "'";
         return nullptr;
       }
@@ -59,8 +59,8 @@ std::unique_ptr<Runtime> Runtime::create(const RuntimeConfig& cfg, const HalBuse
 }
 
 void Runtime::on_device_input(const char* channel, const std::uint8_t* data, int size, std::int64_t, void* user) {
-  Hardware* hw = static_cast<Hardware*>(user);
-  hw->deliver_input(hw->find_input(channel), data, size, monotonic_now_ns());
+  TickPipeline* p = static_cast<TickPipeline*>(user);
+  p->deliver_input(p->hardware()->find_input(channel), data, size, monotonic_now_ns());
 }
 
 Runtime::~Runtime() { stop(); }

@@ -29,6 +29,7 @@ Recorder::Recorder(transport::RecordingInfo info, const RecorderRingSizes& sizes
       codec_(info_.devices),
       ticks_(sizes.ticks > 0 ? sizes.ticks : 1),
       outputs_(sizes.outputs > 0 ? sizes.outputs : 1),
+      inputs_(64),
       bus_lost_(new std::atomic<std::int64_t>[info_.streams.size()]) {
   for (std::size_t i = 0; i < info_.streams.size(); ++i) {
     rings_.push_back(std::make_unique<SpscRing<hal::BusEvent>>(sizes.bus_events > 0 ? sizes.bus_events : 1));
@@ -163,6 +164,28 @@ bool Recorder::record_output(const char* channel, const std::uint8_t* data, int 
   return true;
 }
 
+bool Recorder::record_input(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept {
+  const std::size_t channel_length = channel == nullptr ? 0 : std::strlen(channel);
+  constexpr std::size_t kPrefix = transport::kRecordedInputPrefix.size();
+  if (channel_length == 0 || channel_length + kPrefix > kMaxChannelLength || size < 0 || size > kMaxOutputBytes ||
+      (size > 0 && data == nullptr)) {
+    inputs_rejected_.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  input_staging_.now = now;
+  input_staging_.size = size;
+  char name[kMaxChannelLength + 1];
+  std::memcpy(name, transport::kRecordedInputPrefix.data(), kPrefix);
+  std::memcpy(name + kPrefix, channel, channel_length);
+  input_staging_.channel.assign(std::string_view(name, kPrefix + channel_length));
+  if (size > 0) std::memcpy(input_staging_.data, data, static_cast<std::size_t>(size));
+  if (!inputs_.try_push(input_staging_)) {
+    inputs_lost_.fetch_add(1, std::memory_order_relaxed);
+    return false;
+  }
+  return true;
+}
+
 bool Recorder::start(std::string* error) {
   if (thread_.joinable() || stopped_) {
     set_error(error, "recording: the recorder was already started");
@@ -191,7 +214,7 @@ bool Recorder::stop(std::string* error) {
     // Last, the end record: a log without it was cut short, even between
     // two events. Stamped with the newest event's time, not the clock, so
     // a lockstep simulation records the same bytes every run.
-    std::int64_t lost = ticks_lost_.load() + outputs_lost_.load() + write_errors_.load();
+    std::int64_t lost = ticks_lost_.load() + outputs_lost_.load() + inputs_lost_.load() + write_errors_.load();
     for (std::size_t i = 0; i < info_.streams.size(); ++i) lost += bus_lost_[i].load();
     const std::vector<std::uint8_t> end =
         transport::encode_recording_end({utime_to_ns(last_utime_), writer_.events_written(), lost});
@@ -333,6 +356,13 @@ std::size_t Recorder::drain_once() noexcept {
     outputs_.pop();
     ++written;
   }
+  for (int i = 0; i < kBatch; ++i) {
+    const OutputSlot* in = inputs_.peek();
+    if (in == nullptr) break;
+    write(ns_to_utime(in->now), in->channel.view(), in->data, static_cast<std::size_t>(in->size));
+    inputs_.pop();
+    ++written;
+  }
   return written;
 }
 
@@ -349,6 +379,8 @@ RecorderStats Recorder::stats() const {
   s.ticks_rejected = ticks_rejected_.load(std::memory_order_relaxed);
   s.outputs_lost = outputs_lost_.load(std::memory_order_relaxed);
   s.outputs_rejected = outputs_rejected_.load(std::memory_order_relaxed);
+  s.inputs_lost = inputs_lost_.load(std::memory_order_relaxed);
+  s.inputs_rejected = inputs_rejected_.load(std::memory_order_relaxed);
   s.video_frames_written = video_frames_written_.load(std::memory_order_relaxed);
   s.video_frames_lost = video_frames_lost_.load(std::memory_order_relaxed);
   return s;

@@ -61,6 +61,8 @@ struct RecorderStats {
   std::int64_t ticks_rejected = 0;    // more sensors than a tick record holds
   std::int64_t outputs_lost = 0;      // output ring full
   std::int64_t outputs_rejected = 0;  // larger than kMaxOutputBytes or a bad channel name
+  std::int64_t inputs_lost = 0;       // device input ring full
+  std::int64_t inputs_rejected = 0;   // as outputs_rejected
   // Video rings: frames written, and frames lost to a full ring as the
   // records after each hole report them (their calls also count in
   // bus_events_lost of the camera's stream).
@@ -71,7 +73,9 @@ struct RecorderStats {
 namespace recorder_detail {
 constexpr int kMaxOutputBytes = 8192;
 constexpr std::size_t kMaxChannelLength = 63;
-constexpr int kMaxTickSensors = kMaxSensors;
+// Sensors, then the devices' input channels (Hardware::input_count).
+constexpr int kMaxTickInputs = 8;
+constexpr int kMaxTickSensors = kMaxSensors + kMaxTickInputs;
 
 // Ring slots (outside Recorder: a nested type is incomplete, for SpscRing's
 // checks, until the class ends).
@@ -130,6 +134,12 @@ class Recorder {
   // published: the outputs the loop queued for this tick (Publisher::OutputBit).
   bool record_tick(TimeNs t, std::uint64_t seq, const std::int64_t* consumed, int n,
                    std::uint32_t published = 0) noexcept;
+  // The thread that delivers devices' LCM inputs (the LCM thread live, the
+  // drive in lockstep) only: a message on a device's input channel, before
+  // the device gets it, written on kRecordedInputPrefix + channel. The
+  // tick records count how many of each the loop had taken, so a replay
+  // hands them over at the same ticks. False as record_output.
+  bool record_input(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept;
   // Publisher thread only. The bytes are copied. False: not recorded (ring
   // full, too large, channel empty or longer than kMaxChannelLength), counted.
   bool record_output(const char* channel, const std::uint8_t* data, int size, TimeNs now) noexcept;
@@ -176,10 +186,12 @@ class Recorder {
   std::vector<std::uint8_t> video_buf_;  // encode buffer, sized by add_video_ring
   SpscRing<TickSlot> ticks_;
   SpscRing<OutputSlot> outputs_;
+  SpscRing<OutputSlot> inputs_;
   // Producer-side staging: one per producing thread, so an 8 KiB slot is not
   // built on that thread's stack.
   TickSlot tick_staging_;
   OutputSlot output_staging_;
+  OutputSlot input_staging_;
 
   std::thread thread_;
   std::atomic<bool> stop_requested_{false};
@@ -197,6 +209,8 @@ class Recorder {
   std::atomic<std::int64_t> ticks_rejected_{0};
   std::atomic<std::int64_t> outputs_lost_{0};
   std::atomic<std::int64_t> outputs_rejected_{0};
+  std::atomic<std::int64_t> inputs_lost_{0};
+  std::atomic<std::int64_t> inputs_rejected_{0};
   std::atomic<std::int64_t> video_frames_written_{0};
   std::atomic<std::int64_t> video_frames_lost_{0};
 };

@@ -66,7 +66,20 @@ void TickPipeline::step(TimeNs now, const LoopStats& stats, OutputStage& out) no
   const std::uint32_t due = publisher_->schedule(snap, now);
   const std::uint32_t handed_on = out.deliver(snap, due, now);
   // What was handed on, not what was due: a replay must publish what went out.
-  if (tap_) tap_->recorder().record_tick(now, snap.seq, core_->consumed(), core_->config().num_sensors, handed_on);
+  if (tap_) {
+    const int sensors = core_->config().num_sensors;
+    int n = 0;
+    for (; n < sensors; ++n) consumed_[n] = core_->consumed()[n];
+    const int inputs = hardware_ ? hardware_->input_count() : 0;
+    for (int i = 0; i < inputs && n < runtime::Recorder::kMaxTickSensors; ++i) consumed_[n++] = hardware_->input_taken(i);
+    tap_->recorder().record_tick(now, snap.seq, consumed_, n, handed_on);
+  }
+}
+
+void TickPipeline::deliver_input(int i, const std::uint8_t* data, int size, TimeNs now) noexcept {
+  if (!hardware_ || i < 0 || i >= hardware_->input_count()) return;
+  if (tap_) tap_->recorder().record_input(hardware_->input_channel(i).c_str(), data, size, now);
+  hardware_->deliver_input(i, data, size, now);
 }
 
 bool TickPipeline::stop(std::string* error) { return tap_ ? tap_->recorder().stop(error) : true; }

@@ -79,6 +79,10 @@ class TickPipeline {
   const char* thread_device_name(int i) const { return hardware_->thread_device_name(i); }
   RecordingTap* tap() { return tap_.get(); }
   const RecordingTap* tap() const { return tap_.get(); }
+  // A message on a device's input channel (Hardware::input_channel(i)),
+  // recorded first when recording, then handed to the device. One thread
+  // only: the LCM thread live, the drive or the replay in lockstep.
+  void deliver_input(int i, const std::uint8_t* data, int size, TimeNs now) noexcept;
   // The time the devices were started with.
   TimeNs start_time() const { return start_ns_; }
 
@@ -92,6 +96,8 @@ class TickPipeline {
   std::unique_ptr<runtime::RecordingSink> recording_sink_;
   MessageSink* sink_ = nullptr;
   TimeNs start_ns_ = 0;
+  // A tick's record: the sensors' intake, then the devices' inputs'.
+  std::int64_t consumed_[runtime::Recorder::kMaxTickSensors] = {};
 };
 
 }  // namespace rtfuse

@@ -208,6 +208,10 @@ bool load_hal_recording(EventLogReader& reader, const HalRecordingOptions& optio
                                    std::to_string(rec.events - 1) + ": events are missing or were added");
       }
       ended = true;
+    } else if (starts_with(ev.channel, transport::kRecordedInputPrefix)) {
+      rec.inputs.push_back(RecordedOutput{std::string(ev.channel.substr(transport::kRecordedInputPrefix.size())),
+                                          ev.timestamp_us, ev.event_number,
+                                          std::vector<std::uint8_t>(ev.data, ev.data + ev.size)});
     } else if (starts_with(ev.channel, kRecordChannelPrefix)) {
       return undecodable(ev, ev.channel == kRecordingInfoChannel
                                  ? std::string("a second recording_info_t (two recordings concatenated?)")

@@ -34,6 +34,9 @@ struct HalRecording {
   std::vector<std::unique_ptr<hal::replay::ReplayVideoLog>> videos;
   std::vector<transport::LoopTick> ticks;
   std::vector<RecordedOutput> outputs;
+  // Devices' LCM inputs (the navigator's goals), in their order, each named
+  // by its channel without kRecordedInputPrefix.
+  std::vector<RecordedOutput> inputs;
   std::int64_t events = 0;         // log events loaded
   // The log ends mid-event or without its end record: the recorder was
   // killed or lost power (loaded with allow_truncated).

@@ -89,6 +89,8 @@ class HalReplay {
   // Steps each thread device on its stream until it pushed the samples the
   // live loop had taken by tick t. False when the replay stops there.
   bool catch_up(const transport::LoopTick& t);
+  // Hands each device the recorded inputs the live loop had taken by tick t.
+  void deliver_inputs(const transport::LoopTick& t);
   // A divergence or the end of a stream stops the replay: true then.
   bool stopped_by_a_stream();
   bool stopped_by_video(const hal::replay::ReplayVideoLog* v, const char* device);
@@ -101,6 +103,8 @@ class HalReplay {
   std::unique_ptr<ReplayOutput> output_;
   TimeNs t0_ = 0;
   LoopStats loop_;
+  std::vector<std::size_t> input_cursor_;  // per device input: the next of rec_.inputs to look at
+  std::vector<std::int64_t> inputs_given_;
 };
 
 bool HalReplay::set_up(const RuntimeConfig& given, transport::EventLogWriter* out) {
@@ -183,11 +187,35 @@ bool HalReplay::catch_up(const transport::LoopTick& t) {
   return true;
 }
 
+void HalReplay::deliver_inputs(const transport::LoopTick& t) {
+  Hardware* hw = pipeline_->hardware();
+  if (hw == nullptr || hw->input_count() == 0) return;
+  if (input_cursor_.empty()) {
+    input_cursor_.assign(static_cast<std::size_t>(hw->input_count()), 0);
+    inputs_given_.assign(static_cast<std::size_t>(hw->input_count()), 0);
+  }
+  const std::size_t first = static_cast<std::size_t>(pipeline_->config().num_sensors);
+  for (int i = 0; i < hw->input_count(); ++i) {
+    const std::size_t k = first + static_cast<std::size_t>(i);
+    if (t.consumed.size() <= k) continue;
+    const std::string& channel = hw->input_channel(i);
+    std::size_t& at = input_cursor_[static_cast<std::size_t>(i)];
+    std::int64_t& given = inputs_given_[static_cast<std::size_t>(i)];
+    while (given < t.consumed[k] && at < rec_.inputs.size()) {
+      const RecordedOutput& in = rec_.inputs[at++];
+      if (in.channel != channel) continue;
+      pipeline_->deliver_input(i, in.bytes.data(), static_cast<int>(in.bytes.size()), utime_to_ns(in.utime));
+      ++given;
+    }
+  }
+}
+
 void HalReplay::run_ticks(const std::function<void(const HalReplayProgress&)>& progress) {
   HalReplayProgress prog;
   prog.total_ticks = static_cast<std::int64_t>(rec_.ticks.size());
   for (const transport::LoopTick& t : rec_.ticks) {
     if (!catch_up(t) || stopped_by_a_stream()) break;
+    deliver_inputs(t);
     ++loop_.ticks;
     output_->expect(t.published);
     pipeline_->step(t.time_ns, loop_, *output_);

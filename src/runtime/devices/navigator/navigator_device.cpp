@@ -187,7 +187,10 @@ void NavigatorDevice::reject_goal(const char* why) noexcept {
 
 void NavigatorDevice::take_inputs(const Snapshot& s, TimeNs now) noexcept {
   StopInput st;
-  while (stops_.try_pop(st)) stop_latched_ = st.stop;
+  while (stops_.try_pop(st)) {
+    ++stops_taken_;
+    stop_latched_ = st.stop;
+  }
   GoalInput g;
   while (goals_.try_pop(g)) {
     ++goals_taken_;

@@ -130,6 +130,9 @@ class NavigatorDevice final : public Device, public GridConsumer {
   void fill_snapshot(Snapshot& s) noexcept override;
   void publish_due(TimeNs now, transport::MessageSink& sink) noexcept override;
   void on_input(int channel, const std::uint8_t* data, int size, TimeNs now) noexcept override;
+  std::int64_t inputs_taken(int channel) const noexcept override {
+    return channel == kGoalInput ? goals_taken_ : channel == kStopInput ? stops_taken_ : 0;
+  }
   GridConsumer* grid_consumer() noexcept override { return this; }
 
   // GridConsumer.
@@ -238,6 +241,7 @@ class NavigatorDevice final : public Device, public GridConsumer {
   TimeNs loop_map_stamp_ = 0;
   TimeNs off_path_asked_ = -1;  // tick of the outstanding off-path request
   std::int64_t goals_taken_ = 0;
+  std::int64_t stops_taken_ = 0;
   std::int64_t goals_rejected_ = 0;
   std::int64_t reached_ = 0;
   std::int64_t commands_ = 0;
