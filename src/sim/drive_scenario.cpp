@@ -1,5 +1,6 @@
 #include "sim/drive_scenario.hpp"
 
+#include <algorithm>
 #include <cerrno>
 #include <cmath>
 #include <cstdio>
@@ -360,6 +361,67 @@ void check_clearance(const DriveScenario& sc, const PathPlan& plan, const std::v
   }
 }
 
+// --- [drive], [base], [[goal]] ---------------------------------------------------
+
+void read_base(const Section& s, BaseLimits& b) {
+  s.reject_unknown({"max_wheel_speed_mps", "max_wheel_accel_mps2", "command_latency_s", "command_timeout_s"});
+  read_number(s, "max_wheel_speed_mps", b.max_wheel_speed_mps, in_range(0.0, 10.0), "must be > 0 and <= 10 m/s");
+  read_number(s, "max_wheel_accel_mps2", b.max_wheel_accel_mps2, in_range(0.0, 50.0),
+              "must be > 0 and <= 50 m/s^2");
+  read_number(s, "command_latency_s", b.command_latency_s, in_range(0.0, 1.0),
+              "must be > 0 and <= 1 s (a command acts after it arrives, never at the instant it is issued)");
+  read_number(s, "command_timeout_s", b.command_timeout_s, in_range(0.0, 60.0), "must be > 0 and <= 60 s");
+}
+
+// The distance from (x, y) to a box's footprint; 0 inside it.
+double obstacle_gap(const ObstacleBox& o, double x, double y) noexcept {
+  const double dx = std::max(std::abs(x - o.x) - 0.5 * o.size_x, 0.0);
+  const double dy = std::max(std::abs(y - o.y) - 0.5 * o.size_y, 0.0);
+  return std::sqrt(dx * dx + dy * dy);
+}
+
+// Where the robot must be able to stand: the path's clearance rule.
+double standing_clearance(const RobotBody& robot) noexcept { return 0.5 * robot.track_width_m + 0.1; }
+
+// Goals are read after the robot and the obstacles: a goal the robot
+// cannot stand at would only show as a navigator that never arrives.
+void read_goals(const Section& root, DriveScenario& sc, std::vector<toml::source_region>& where) {
+  const CameraWorldConfig world;
+  const double need = standing_clearance(sc.robot);
+  config::for_each_table(root, "goal", kMaxDriveGoals, [&](const Section& s, bool fits) {
+    s.reject_unknown({"x_m", "y_m", "yaw_deg", "tolerance_m"});
+    s.require({"x_m", "y_m"});
+    DriveGoal g;
+    const bool x = read_number(s, "x_m", g.x_m, [&](double v) { return v >= world.min_x && v <= world.max_x; },
+                               "must be within the drive area's x " + fmt(world.min_x) + ".." + fmt(world.max_x) +
+                                   " m");
+    const bool y = read_number(s, "y_m", g.y_m, [&](double v) { return v >= world.min_y && v <= world.max_y; },
+                               "must be within the drive area's y " + fmt(world.min_y) + ".." + fmt(world.max_y) +
+                                   " m");
+    double yaw = 0.0;
+    if (read_number(s, "yaw_deg", yaw, [](double v) { return v >= -360.0 && v <= 360.0; },
+                    "must be within -360..360 deg")) {
+      g.has_yaw = true;
+      g.yaw_rad = yaw * kDeg;
+    }
+    read_number(s, "tolerance_m", g.tolerance_m, in_range(0.0, 10.0), "must be > 0 and <= 10 m");
+    where.push_back(s.key_where("x_m"));
+    g.line = static_cast<int>(where.back().begin.line);
+    if (x && y) {
+      for (std::size_t i = 0; i < sc.obstacles.size(); ++i) {
+        const double d = obstacle_gap(sc.obstacles[i], g.x_m, g.y_m);
+        if (d <= 0.0) {
+          s.key_error("x_m", "the goal is inside obstacle[" + std::to_string(i) + "]");
+        } else if (d < need) {
+          s.key_error("x_m", "the goal is " + fmt(d) + " m from obstacle[" + std::to_string(i) +
+                                 "]; the robot needs " + fmt(need) + " m to stand there (half its track and 0.1 m)");
+        }
+      }
+    }
+    if (fits) sc.goals.push_back(g);
+  });
+}
+
 // --- [imu] --------------------------------------------------------------------
 
 void read_triple(const Section& s, std::string_view k, double scale, std::array<double, 3>& out) {
@@ -451,10 +513,18 @@ void read_gnss(const Section& s, SimGnssConfig& g) {
 
 // --- root -------------------------------------------------------------------
 
-void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_region>& path_where,
-               std::vector<toml::source_region>& obstacle_where) {
-  root.reject_unknown({"duration_s", "seed", "limits", "path", "robot", "slip", "dropout", "imu", "gnss", "obstacle"});
+// Where the entries are in the file, for the checks after reading.
+struct EntryPlaces {
+  std::vector<toml::source_region> path, obstacle, goal;
+};
+
+void read_root(const Section& root, DriveScenario& sc, EntryPlaces& where) {
+  root.reject_unknown({"duration_s", "seed", "drive", "base", "goal", "limits", "path", "robot", "slip", "dropout",
+                       "imu", "gnss", "obstacle"});
   Diagnostics& d = root.diag();
+  const Section drive(config::section_table(root, "drive"), "drive", d);
+  drive.reject_unknown({"mode"});
+  if (read_choice(drive, "mode", {"path", "commanded"}) == 1) sc.mode = DriveMode::kCommanded;
   read_number(root, "duration_s", sc.duration_s, in_range(0.0, 86400.0),
               "must be > 0 and <= 86400 s (leave it out to run as long as the path takes)");
   std::int64_t seed = 1;
@@ -472,9 +542,9 @@ void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_
   config::for_each_table(root, "path", std::numeric_limits<int>::max(), [&](const Section& s, bool) {
     PathSegment g;
     read_segment(s, g);
-    path_where.push_back(s.key_where("type"));
-    g.line = static_cast<int>(path_where.back().begin.line);
-    g.column = static_cast<int>(path_where.back().begin.column);
+    where.path.push_back(s.key_where("type"));
+    g.line = static_cast<int>(where.path.back().begin.line);
+    g.column = static_cast<int>(where.path.back().begin.column);
     sc.path.push_back(g);
   });
 
@@ -483,7 +553,39 @@ void read_root(const Section& root, DriveScenario& sc, std::vector<toml::source_
   read_dropouts(root, sc);
   read_imu(Section(config::section_table(root, "imu"), "imu", d), sc.imu);
   if (const toml::table* gnss = config::section_table(root, "gnss")) read_gnss(Section(gnss, "gnss", d), sc.gnss);
-  read_obstacles(root, sc, obstacle_where);
+  read_obstacles(root, sc, where.obstacle);
+  read_base(Section(config::section_table(root, "base"), "base", d), sc.base);
+  read_goals(root, sc, where.goal);
+
+  if (sc.mode == DriveMode::kCommanded) {
+    if (!where.path.empty()) {
+      d.add(where.path.front(), "path",
+            "a commanded drive ([drive] mode = 'commanded') follows velocity commands, not a scripted path: "
+            "remove the [[path]] entries, or set mode = 'path'");
+    }
+    if (!root.has("duration_s")) {
+      d.add(drive.value_where("mode"), "duration_s",
+            "missing: a commanded drive needs a duration_s (there is no path to take the length from)");
+    }
+    // The drive starts at the origin, facing +x: the robot must fit there.
+    const double need = standing_clearance(sc.robot);
+    for (std::size_t i = 0; i < sc.obstacles.size(); ++i) {
+      const double gap = obstacle_gap(sc.obstacles[i], 0.0, 0.0);
+      if (gap < need) {
+        d.add(where.obstacle[i], "obstacle[" + std::to_string(i) + "]",
+              "the robot starts at the origin, " + fmt(gap) + " m from this obstacle; it needs " + fmt(need) +
+                  " m (half its track and 0.1 m)");
+      }
+    }
+  } else {
+    if (root.has("base")) {
+      root.key_error("base", "only a commanded drive has a [base]: set [drive] mode = 'commanded'");
+    }
+    if (!where.goal.empty()) {
+      d.add(where.goal.front(), "goal",
+            "goals are for the navigator of a commanded drive: set [drive] mode = 'commanded'");
+    }
+  }
 }
 
 }  // namespace
@@ -506,16 +608,16 @@ bool load_drive_scenario_string(std::string_view toml_text, const std::string& s
   sc.source = source_name;
   if (const std::optional<toml::table> root = config::parse(toml_text, source_name, diag)) {
     const Section top(&*root, "", diag);
-    std::vector<toml::source_region> path_where, obstacle_where;
-    read_root(top, sc, path_where, obstacle_where);
-    if (diag.empty()) {
+    EntryPlaces where;
+    read_root(top, sc, where);
+    if (diag.empty() && sc.mode == DriveMode::kPath) {
       // The drive itself: can every segment be driven within the limits, and
       // do the run's timed events fall inside it?
       PathPlan plan;
       PlanProblem problem;
       if (!PathPlan::build(sc, &plan, &problem)) {
         if (problem.segment >= 0) {
-          diag.add(path_where[static_cast<std::size_t>(problem.segment)],
+          diag.add(where.path[static_cast<std::size_t>(problem.segment)],
                    "path[" + std::to_string(problem.segment) + "]", problem.message);
         } else {
           top.table_error("path", problem.message);
@@ -529,7 +631,7 @@ bool load_drive_scenario_string(std::string_view toml_text, const std::string& s
         if (sc.duration_s <= 0.0 && plan.end_time() <= 0.0) {
           top.table_error("duration_s", "the path is empty: give a duration_s for the robot to stand still");
         }
-        check_clearance(sc, plan, obstacle_where, diag);
+        check_clearance(sc, plan, where.obstacle, diag);
       }
     }
   }

@@ -1,8 +1,9 @@
 #pragma once
-// A drive of the bus-level simulated robot: the path it drives, the robot
-// as it really is (geometry, encoders, calibration error), the wheel slip,
-// the encoder dropouts and the IMU, read from a scenario TOML file
-// (config/scenarios/*.toml documents every key).
+// A drive of the bus-level simulated robot: the path it drives (or, in a
+// commanded drive, its base's limits and the goals a navigator is given),
+// the robot as it really is (geometry, encoders, calibration error), the
+// wheel slip, the encoder dropouts and the IMU, read from a scenario TOML
+// file (config/scenarios/*.toml documents every key).
 //
 // Units inside are SI and radians; the file uses the units its key names
 // say (angle_deg, yaw_rate_dps...). Configuration time only: loading
@@ -24,6 +25,7 @@ constexpr int kMaxSimWheels = 4;
 constexpr int kMaxSlipEpisodes = 16;
 constexpr int kMaxDropouts = 16;
 constexpr int kMaxGnssOutages = 16;
+constexpr int kMaxDriveGoals = 64;
 
 enum class SegmentType : std::uint8_t { kStraight, kArc, kSpin, kFigureEight, kStop };
 
@@ -142,8 +144,35 @@ struct SimGnssConfig {
   std::array<GnssOutage, kMaxGnssOutages> outages{};
 };
 
+// [drive] mode: a scripted [[path]], or a base that follows velocity
+// commands (commanded_base.hpp).
+enum class DriveMode : std::uint8_t { kPath, kCommanded };
+
+// [base]: the commanded base's drive. A command (v, w) asks each side for
+// v -/+ w * track / 2; the wheels go no faster than max_wheel_speed and
+// change speed no faster than max_wheel_accel.
+struct BaseLimits {
+  double max_wheel_speed_mps = 1.0;
+  double max_wheel_accel_mps2 = 1.0;
+  // A command acts this long after it was issued (the bus and the motor
+  // controller's cycle).
+  double command_latency_s = 0.02;
+  // With no command newer than this in effect, the base stops by itself.
+  double command_timeout_s = 0.5;
+};
+
+// [[goal]]: where the navigator is sent, in order, odom frame.
+struct DriveGoal {
+  double x_m = 0.0, y_m = 0.0;
+  bool has_yaw = false;
+  double yaw_rad = 0.0;  // the heading to arrive with, when has_yaw
+  double tolerance_m = 0.3;
+  int line = 0;  // where the entry starts in the file
+};
+
 struct DriveScenario {
   std::string source;   // the file it came from
+  DriveMode mode = DriveMode::kPath;
   double duration_s = 0.0;  // the run; 0 = as long as the path takes
   std::uint64_t seed = 1;
   MotionLimits limits;
@@ -156,6 +185,9 @@ struct DriveScenario {
   SimGnssConfig gnss;
   // [[obstacle]]: solids inside the drive area; the path keeps its distance.
   std::vector<ObstacleBox> obstacles;
+  // A commanded drive's (mode kCommanded; duration_s is then set, path empty).
+  BaseLimits base;
+  std::vector<DriveGoal> goals;
 };
 
 // Reads and validates a scenario. On failure returns false and sets *error

@@ -4,6 +4,7 @@
 
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <cmath>
 #include <string>
 
@@ -426,6 +427,199 @@ duration_s = 2.0
   EXPECT_NE(load_error(path + "[gnss]\nrate = 5.0\n").find("gnss.rate: unknown key (did you mean 'rate_hz'?)"), std::string::npos)
       << load_error(path + "[gnss]\nrate = 5.0\n");
   EXPECT_NE(load_error(path + "[gnss]\n[[gnss.outage]]\nstart_s = 1.0\n").find("duration_s"), std::string::npos);
+}
+
+
+// --- a commanded drive: [drive], [base], [[goal]] ----------------------------------
+
+TEST(DriveScenario, CommandedDriveReadsItsBaseAndGoals) {
+  const DriveScenario sc = load_ok(R"(duration_s = 90.0
+[drive]
+mode = "commanded"
+[base]
+max_wheel_speed_mps = 1.5
+max_wheel_accel_mps2 = 2.0
+command_latency_s = 0.05
+command_timeout_s = 0.25
+[[goal]]
+x_m = 3.0
+y_m = -1.5
+[[goal]]
+x_m = -2.0
+y_m = 4.0
+yaw_deg = -90.0
+tolerance_m = 0.1
+)" + kRobot);
+  EXPECT_EQ(sc.mode, DriveMode::kCommanded);
+  EXPECT_EQ(sc.duration_s, 90.0);
+  EXPECT_TRUE(sc.path.empty());
+  EXPECT_EQ(sc.base.max_wheel_speed_mps, 1.5);
+  EXPECT_EQ(sc.base.max_wheel_accel_mps2, 2.0);
+  EXPECT_EQ(sc.base.command_latency_s, 0.05);
+  EXPECT_EQ(sc.base.command_timeout_s, 0.25);
+  ASSERT_EQ(sc.goals.size(), 2u);
+  EXPECT_EQ(sc.goals[0].x_m, 3.0);
+  EXPECT_EQ(sc.goals[0].y_m, -1.5);
+  EXPECT_FALSE(sc.goals[0].has_yaw);
+  EXPECT_EQ(sc.goals[0].tolerance_m, 0.3);  // the default
+  EXPECT_EQ(sc.goals[0].line, 10);
+  EXPECT_TRUE(sc.goals[1].has_yaw);
+  EXPECT_DOUBLE_EQ(sc.goals[1].yaw_rad, -0.5 * kPi);
+  EXPECT_EQ(sc.goals[1].tolerance_m, 0.1);
+
+  // The defaults, and a scripted drive stays one.
+  const DriveScenario bare = load_ok("duration_s = 5.0\n[drive]\nmode = \"commanded\"\n" + kRobot);
+  EXPECT_EQ(bare.base.max_wheel_speed_mps, 1.0);
+  EXPECT_EQ(bare.base.max_wheel_accel_mps2, 1.0);
+  EXPECT_EQ(bare.base.command_latency_s, 0.02);
+  EXPECT_EQ(bare.base.command_timeout_s, 0.5);
+  EXPECT_TRUE(bare.goals.empty());
+  EXPECT_EQ(load_ok("duration_s = 5.0\n" + kRobot).mode, DriveMode::kPath);
+  EXPECT_EQ(load_ok("duration_s = 5.0\n[drive]\nmode = \"path\"\n" + kRobot).mode, DriveMode::kPath);
+}
+
+TEST(DriveScenario, CommandedDriveNeedsADurationAndNoPath) {
+  const std::string e = load_error(R"([drive]
+mode = "commanded"
+[[path]]
+type = "straight"
+length_m = 3.0
+speed_mps = 1.0
+)" + kRobot);
+  EXPECT_NE(e.find("t.toml:2:8: duration_s: missing: a commanded drive needs a duration_s"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:4:1: path: a commanded drive ([drive] mode = 'commanded') follows velocity commands, "
+                   "not a scripted path"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(load_error("[drive]\nmode = \"remote\"\n" + kRobot)
+                .find("t.toml:2:8: drive.mode: must be one of 'path', 'commanded', got 'remote'"),
+            std::string::npos);
+}
+
+TEST(DriveScenario, BaseAndGoalErrorsAreReportedAtTheirKeys) {
+  const std::string e = load_error(R"(duration_s = 60.0
+[drive]
+mode = "commanded"
+[base]
+max_wheel_speed_mps = 0.0
+max_wheel_accel_mps2 = 100.0
+command_latency_s = 0.0
+command_timeout_s = -1.0
+max_speed = 1.0
+[[goal]]
+x_m = 50.0
+y_m = nan
+[[goal]]
+x_m = 2.5
+y_m = 3.0
+yaw_deg = 400.0
+tolerance_m = 0.0
+[[goal]]
+x_m = 2.5
+y_m = 3.3
+[[goal]]
+y_m = 1.0
+heading_deg = 10.0
+[[obstacle]]
+x_m = 2.5
+y_m = 3.0
+size_x_m = 0.3
+size_y_m = 0.3
+[[obstacle]]
+x_m = 0.4
+y_m = 0.0
+size_x_m = 0.3
+size_y_m = 0.3
+)" + kRobot);
+  EXPECT_NE(e.find("t.toml:5:23: base.max_wheel_speed_mps: must be > 0 and <= 10 m/s, got 0"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:6:24: base.max_wheel_accel_mps2: must be > 0 and <= 50 m/s^2, got 100"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:7:21: base.command_latency_s: must be > 0 and <= 1 s"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:8:21: base.command_timeout_s: must be > 0 and <= 60 s, got -1"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:9:1: base.max_speed: unknown key"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:11:7: goal[0].x_m: must be within the drive area's x -6..18.5 m, got 50"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:12:7: goal[0].y_m: must be within the drive area's y -6.5..19 m, got nan"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:16:11: goal[1].yaw_deg: must be within -360..360 deg, got 400"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:17:15: goal[1].tolerance_m: must be > 0 and <= 10 m, got 0"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:14:1: goal[1].x_m: the goal is inside obstacle[0]"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:19:1: goal[2].x_m: the goal is 0.15 m from obstacle[0]; the robot needs 0.35 m"),
+            std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:21:1: goal[3].x_m: missing required key"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:23:1: goal[3].heading_deg: unknown key"), std::string::npos) << e;
+  // The robot starts at the origin, 0.25 m from the second box.
+  EXPECT_NE(e.find("obstacle[1]: the robot starts at the origin, 0.25 m from this obstacle; it needs 0.35 m"),
+            std::string::npos)
+      << e;
+}
+
+TEST(DriveScenario, BaseAndGoalsBelongToACommandedDrive) {
+  const std::string e = load_error(R"([[path]]
+type = "straight"
+length_m = 3.0
+speed_mps = 1.0
+[base]
+max_wheel_speed_mps = 1.0
+[[goal]]
+x_m = 1.0
+y_m = 1.0
+)" + kRobot);
+  EXPECT_NE(e.find("t.toml:5:2: base: only a commanded drive has a [base]"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:8:1: goal: goals are for the navigator of a commanded drive"), std::string::npos) << e;
+}
+
+TEST(DriveScenario, ObstacleGoalsIsTheObstacleCourseDrivenToGoals) {
+  DriveScenario goals, course;
+  std::string error;
+  ASSERT_TRUE(load_drive_scenario(RTFUSE_SOURCE_DIR "/config/scenarios/obstacle_goals.toml", &goals, &error)) << error;
+  ASSERT_TRUE(load_drive_scenario(RTFUSE_SOURCE_DIR "/config/scenarios/obstacles.toml", &course, &error)) << error;
+  EXPECT_EQ(goals.mode, DriveMode::kCommanded);
+  EXPECT_EQ(goals.duration_s, 240.0);
+  EXPECT_TRUE(goals.path.empty());
+  ASSERT_EQ(goals.goals.size(), 10u);
+  ASSERT_EQ(goals.obstacles.size(), course.obstacles.size());
+  for (std::size_t i = 0; i < course.obstacles.size(); ++i) {
+    EXPECT_EQ(goals.obstacles[i].x, course.obstacles[i].x);
+    EXPECT_EQ(goals.obstacles[i].y, course.obstacles[i].y);
+    EXPECT_EQ(goals.obstacles[i].size_x, course.obstacles[i].size_x);
+    EXPECT_EQ(goals.obstacles[i].size_y, course.obstacles[i].size_y);
+    EXPECT_EQ(goals.obstacles[i].height, course.obstacles[i].height);
+  }
+  EXPECT_EQ(goals.robot.track_width_m, course.robot.track_width_m);
+  EXPECT_EQ(goals.seed, course.seed);
+  // One goal beyond the narrow passage (the blocks either side of x = 8,
+  // y 4..6), reached from the goal before it, below the passage.
+  bool through_passage = false;
+  for (std::size_t i = 1; i < goals.goals.size(); ++i) {
+    const DriveGoal& a = goals.goals[i - 1];
+    const DriveGoal& b = goals.goals[i];
+    through_passage = through_passage || (a.y_m < 4.0 && b.y_m > 6.0 && a.x_m > 7.4 && a.x_m < 8.6 &&
+                                          b.x_m > 7.4 && b.x_m < 8.6);
+  }
+  EXPECT_TRUE(through_passage);
+  // Some goals lie behind a pillar: the straight line from the goal before
+  // passes closer to a pillar than the robot's half track.
+  int behind_pillar = 0;
+  for (std::size_t i = 1; i < goals.goals.size(); ++i) {
+    const DriveGoal& a = goals.goals[i - 1];
+    const DriveGoal& b = goals.goals[i];
+    for (int p = 0; p < 3; ++p) {  // the three pillars come first
+      const ObstacleBox& o = goals.obstacles[static_cast<std::size_t>(p)];
+      const double dx = b.x_m - a.x_m, dy = b.y_m - a.y_m;
+      const double u = std::clamp(((o.x - a.x_m) * dx + (o.y - a.y_m) * dy) / (dx * dx + dy * dy), 0.0, 1.0);
+      const double ex = a.x_m + u * dx - o.x, ey = a.y_m + u * dy - o.y;
+      if (std::sqrt(ex * ex + ey * ey) < 0.5 * goals.robot.track_width_m + 0.5 * o.size_x) ++behind_pillar;
+    }
+  }
+  EXPECT_GE(behind_pillar, 3);
+  // Back home at the end.
+  EXPECT_EQ(goals.goals.back().x_m, 0.0);
+  EXPECT_EQ(goals.goals.back().y_m, 0.0);
 }
 
 }  // namespace drive_scenario_test
