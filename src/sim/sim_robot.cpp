@@ -28,7 +28,12 @@ std::unique_ptr<SimRobot> SimRobot::create(const RuntimeConfig& cfg, const std::
   }
   r->clock_ = &clock;
   r->t0_ = t0;
-  const SimDeviceContext ctx{cfg, r->scenario_, path, *r->truth_, clock, t0};
+  if (r->commanded()) {
+    // The noise over the whole run: there is no path to end it earlier.
+    r->slip_ = std::make_unique<WheelSlipModel>(r->scenario_, r->scenario_.duration_s);
+    r->commands_ = std::make_unique<CommandFeed>();
+    r->own_truth_ = r->make_truth_reader();
+  }
   for (int i = 0; i < device_type_count(); ++i) {
     const DeviceDescriptor& d = device_type(i);
     // A device on another's frames (the visual odometry) has no buses.
@@ -39,6 +44,14 @@ std::unique_ptr<SimRobot> SimRobot::create(const RuntimeConfig& cfg, const std::
                d.name();
       return nullptr;
     }
+    // Each device reads truth on its own thread: a commanded robot gives it
+    // its own integrator, a scripted one the shared, thread-safe trajectory.
+    TruthSource* truth = r->truth_.get();
+    if (r->commanded()) {
+      r->device_truth_[i] = r->make_truth_reader();
+      truth = r->device_truth_[i].get();
+    }
+    const SimDeviceContext ctx{cfg, r->scenario_, path, *truth, clock, t0};
     r->devices_[i] = c->create(ctx, error);
     if (!r->devices_[i]) return nullptr;
   }
@@ -55,7 +68,39 @@ HalBuses SimRobot::buses() {
 
 double SimRobot::duration_s() const { return truth_->duration_s(); }
 
-TruthState SimRobot::truth_at(TimeNs t) const noexcept { return truth_->truth_at(ns_to_sec(t - t0_)); }
+TruthState SimRobot::truth_at(TimeNs t) const noexcept {
+  if (own_truth_) return own_truth_->truth_at(ns_to_sec(t - t0_));
+  return truth_->truth_at(ns_to_sec(t - t0_));
+}
+
+std::unique_ptr<CommandedTruth> SimRobot::make_truth_reader() const {
+  if (!commanded()) return nullptr;
+  return std::make_unique<CommandedTruth>(scenario_, *slip_, *commands_, t0_);
+}
+
+const CommandedTruth* SimRobot::device_truth(std::string_view name) const noexcept {
+  const int i = find_device_type(name);
+  return i < 0 ? nullptr : device_truth_[i].get();
+}
+
+SimRobot::CommandedCounters SimRobot::commanded_counters() const noexcept {
+  CommandedCounters c;
+  if (!commanded()) return c;
+  const auto add = [&c](const CommandedTruth& r) {
+    c.late_commands += r.late_commands();
+    c.feed_overruns += r.feed_overruns();
+    c.history_misses += r.history_misses();
+    c.far_queries += r.far_queries();
+  };
+  for (const auto& r : device_truth_) {
+    if (r) add(*r);
+  }
+  add(*own_truth_);
+  c.watchdog_stops = own_truth_->watchdog_stops();
+  c.rejected_commands = commands_->rejected_out_of_order();
+  c.non_finite_commands = commands_->non_finite();
+  return c;
+}
 
 GroundTruthEncoder::GroundTruthEncoder() {
   fill_ground_truth(TruthState{}, 0, 0, &msg_);
