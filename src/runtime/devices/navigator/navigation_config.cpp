@@ -39,7 +39,7 @@ void read_follower(const Section& s, navigation::FollowerParams& f) {
 }
 
 void read_navigation(const Section& s, NavigationSection& n) {
-  s.reject_unknown({"follow", "goal_channel", "stop_channel", "path_channel", "cmd_vel_channel", "status_channel",
+  s.reject_unknown({"follow", "drop_speckles", "goal_channel", "stop_channel", "path_channel", "cmd_vel_channel", "status_channel",
                     "inscribed_radius", "inflation_radius", "cost_scaling_factor", "unknown", "cost_weight",
                     "map_delay", "plan_delay", "off_path", "max_linear", "max_angular", "max_linear_accel",
                     "max_linear_decel", "max_angular_accel", "lookahead_time", "min_lookahead", "max_lookahead",
@@ -47,6 +47,7 @@ void read_navigation(const Section& s, NavigationSection& n) {
                     "rotate_to_heading_angle_deg", "command_rate", "estimate_timeout", "map_timeout"});
   n.enabled = true;
   s.read("follow", n.follow);
+  s.read("drop_speckles", n.drop_speckles);
   s.read_name("goal_channel", n.goal_channel);
   s.read_name("stop_channel", n.stop_channel);
   s.read_name("path_channel", n.path_channel);

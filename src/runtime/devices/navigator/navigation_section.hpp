@@ -26,6 +26,10 @@ struct NavigationSection {
   // Unknown cells: "free" (a robot exploring drives into what it has not
   // seen; it starts with an empty map) or "blocked".
   bool unknown_free = true;
+  // Lone obstacle cells read as free (navigation/speckle_filter.hpp):
+  // stereo's scattered false hits would otherwise each close a disc of
+  // the inscribed radius.
+  bool drop_speckles = false;
   // The planner: a step's cost is its length times 1 + cost_weight *
   // cost / 252.
   double cost_weight = 2.0;

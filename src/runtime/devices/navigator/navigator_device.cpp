@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "navigation/path_clearance.hpp"
+#include "navigation/speckle_filter.hpp"
 
 namespace rtfuse {
 
@@ -18,11 +19,11 @@ namespace rtfuse {
 // took after their time had passed (live only; a replay may then differ);
 // inputs_dropped: goals or stops a full ring refused; inputs_bad: stops
 // that did not decode; lost: estimates, requests or results a full ring
-// refused.
-const char* const kNavigatorKeys[18] = {"goals",       "rejected",       "reached",     "plans",     "plan_failures",
+// refused; speckles: lone obstacle cells the last grid had (drop_speckles).
+const char* const kNavigatorKeys[19] = {"goals",       "rejected",       "reached",     "plans",     "plan_failures",
                                         "replans_blocked", "replans_off_path", "replans_map", "expansions", "plan_us",
                                         "max_plan_us", "grids",          "grids_dropped", "costmap_us", "late",
-                                        "inputs_dropped", "inputs_bad",   "lost"};
+                                        "inputs_dropped", "inputs_bad",   "lost",        "speckles"};
 
 namespace {
 
@@ -115,6 +116,7 @@ std::unique_ptr<NavigatorDevice> NavigatorDevice::create(GridSource& mapper, Fus
     d->free_paths_.try_push(i);
   }
   d->path_.reset(new navigation::Point2[static_cast<std::size_t>(d->max_points_)]);
+  if (n.drop_speckles) d->filtered_.reset(new std::int8_t[cells]);
   for (int i = 0; i < 3; ++i) {
     d->display_.buffer(i).points.reset(new transport::PathPoint2[static_cast<std::size_t>(d->max_points_)]);
   }
@@ -343,7 +345,7 @@ void NavigatorDevice::fill_snapshot(Snapshot& s) noexcept {
                      v.replans_map, v.expansions, v.plan_ns / 1000, v.max_plan_ns / 1000, v.grids,
                      grids_dropped_.load(std::memory_order_relaxed), v.costmap_ns / 1000, v.late,
                      inputs_dropped_.load(std::memory_order_relaxed), inputs_bad_.load(std::memory_order_relaxed),
-                     lost_.load(std::memory_order_relaxed)});
+                     lost_.load(std::memory_order_relaxed), v.speckles});
   const navigation::StopReason reason = static_cast<navigation::StopReason>(nav_.stop_reason);
   d.state = navigation::to_string(reason);
   set_device_message(d.message, nav_.goal_error);
@@ -461,7 +463,13 @@ void NavigatorDevice::apply_grid(const GridNote& note, TimeNs t) noexcept {
     return;
   }
   const TimeNs t0 = monotonic_now_ns();
-  costmap_->update(grid_slots_[note.slot].get());
+  const std::int8_t* grid = grid_slots_[note.slot].get();
+  if (filtered_) {
+    stats_.speckles = static_cast<std::int64_t>(navigation::drop_speckles(
+        grid, filtered_.get(), layout_.width, layout_.height, costmap_->params().occupied_from));
+    grid = filtered_.get();
+  }
+  costmap_->update(grid);
   stats_.costmap_ns = monotonic_now_ns() - t0;
   ++stats_.grids;
   free_grids_.try_push(note.slot);

@@ -50,7 +50,7 @@
 
 namespace rtfuse {
 
-extern const char* const kNavigatorKeys[18];
+extern const char* const kNavigatorKeys[19];
 
 namespace navigator_detail {
 // Ring slots (outside the class, as the mapper's: default-constructible
@@ -96,6 +96,7 @@ struct NavStats {
   TimeNs max_plan_ns = 0;
   std::int64_t grids = 0;
   TimeNs costmap_ns = 0;        // the last update's
+  std::int64_t speckles = 0;    // lone obstacle cells dropped from the last grid
   std::int64_t late = 0;        // grids processed after their time had passed (live only)
 };
 struct GoalInput {
@@ -213,6 +214,7 @@ class NavigatorDevice final : public Device, public GridConsumer {
 
   // Navigator thread.
   std::unique_ptr<navigation::Costmap> costmap_;
+  std::unique_ptr<std::int8_t[]> filtered_;  // the grid without its speckles (drop_speckles)
   std::unique_ptr<navigation::GridPlanner> planner_;
   navigation::PlannerParams planner_params_;
   LoopPose pose_;  // the loop's newest estimate up to the event in work
