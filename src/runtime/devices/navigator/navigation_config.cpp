@@ -40,7 +40,7 @@ void read_follower(const Section& s, navigation::FollowerParams& f) {
 
 void read_navigation(const Section& s, NavigationSection& n) {
   s.reject_unknown({"follow", "drop_speckles", "goal_channel", "stop_channel", "path_channel", "cmd_vel_channel", "status_channel",
-                    "inscribed_radius", "inflation_radius", "cost_scaling_factor", "unknown", "cost_weight",
+                    "inscribed_radius", "inflation_radius", "cost_scaling_factor", "unknown", "cost_weight", "smooth_cost",
                     "map_delay", "plan_delay", "off_path", "max_linear", "max_angular", "max_linear_accel",
                     "max_linear_decel", "max_angular_accel", "lookahead_time", "min_lookahead", "max_lookahead",
                     "goal_tolerance", "approach_distance", "min_approach_speed", "regulated_min_radius",
@@ -69,6 +69,7 @@ void read_navigation(const Section& s, NavigationSection& n) {
   }
   read_number(s, "cost_weight", n.cost_weight, [](double v) { return v >= 0 && v <= 1000.0; },
               "must be between 0 and 1000");
+  read_int(s, "smooth_cost", n.smooth_cost, 0, 253);
   read_number(s, "map_delay", n.map_delay_s, [](double v) { return v >= 0 && v <= 10.0; },
               "must be between 0 and 10 s");
   read_number(s, "plan_delay", n.plan_delay_s, [](double v) { return v >= 0 && v <= 10.0; },

@@ -33,6 +33,14 @@ struct NavigationSection {
   // The planner: a step's cost is its length times 1 + cost_weight *
   // cost / 252.
   double cost_weight = 2.0;
+  // The path followed is the plan smoothed: straight segments over cells
+  // whose cost is below smooth_cost (100: about 0.19 m beyond the inscribed
+  // radius with the default decay), so a segment keeps its distance from
+  // what the map calls an obstacle; 0: the plan's cells as they are.
+  // Straight segments matter beyond looks: on a staircase of grid cells the
+  // pursuit turns by a few hundredths of a radian a second all the time,
+  // which an IMU learning its bias at standstill takes for a bias.
+  int smooth_cost = 100;
   // Determinism budgets (docs/design.md, "The navigator"): a grid made from
   // the keyframes up to stamp s is planned on from tick s + map_delay; a
   // plan asked at tick t is followed from tick t + plan_delay.

@@ -7,6 +7,7 @@
 #include <stdexcept>
 
 #include "navigation/path_clearance.hpp"
+#include "navigation/path_smoother.hpp"
 #include "navigation/speckle_filter.hpp"
 
 namespace rtfuse {
@@ -116,6 +117,7 @@ std::unique_ptr<NavigatorDevice> NavigatorDevice::create(GridSource& mapper, Fus
     d->free_paths_.try_push(i);
   }
   d->path_.reset(new navigation::Point2[static_cast<std::size_t>(d->max_points_)]);
+  d->smoothed_.reset(new navigation::GridCell[static_cast<std::size_t>(d->max_points_)]);
   if (n.drop_speckles) d->filtered_.reset(new std::int8_t[cells]);
   for (int i = 0; i < 3; ++i) {
     d->display_.buffer(i).points.reset(new transport::PathPoint2[static_cast<std::size_t>(d->max_points_)]);
@@ -436,9 +438,17 @@ void NavigatorDevice::plan_and_send(TimeNs t, const LoopPose& from, PlanCause ca
     return;
   }
   navigation::Point2* pts = path_slots_[slot].get();
-  const int n = static_cast<int>(pr.path_cells);
+  const navigation::GridCell* cells = pr.path;
+  std::size_t count = pr.path_cells;
+  if (config_.smooth_cost > 0) {
+    navigation::Passability margin = planner_params_.passability;
+    margin.lethal_from = static_cast<std::uint8_t>(std::min<int>(config_.smooth_cost, margin.lethal_from));
+    count = navigation::smooth_path(costmap_->view(), margin, pr.path, pr.path_cells, smoothed_.get());
+    cells = smoothed_.get();
+  }
+  const int n = static_cast<int>(count);
   for (int i = 0; i < n; ++i) {
-    pts[i] = navigation::Point2{ox + (pr.path[i].x + 0.5) * r, oy + (pr.path[i].y + 0.5) * r};
+    pts[i] = navigation::Point2{ox + (cells[i].x + 0.5) * r, oy + (cells[i].y + 0.5) * r};
   }
   std::copy(pts, pts + n, path_.get());
   path_size_ = n;

@@ -225,6 +225,7 @@ class NavigatorDevice final : public Device, public GridConsumer {
   double goal_x_ = 0.0, goal_y_ = 0.0;
   bool path_ok_ = false;  // a path to the current goal was sent
   std::unique_ptr<navigation::Point2[]> path_;  // the last path sent, for the blocked check
+  std::unique_ptr<navigation::GridCell[]> smoothed_;  // workspace of the smoothing
   int path_size_ = 0;
   navigator_detail::NavStats stats_;
   SeqLock<navigator_detail::NavStats> health_;
