@@ -7,6 +7,7 @@
 #include <cmath>
 #include <cstdio>
 #include <cstring>
+#include <limits>
 #include <memory>
 #include <thread>
 
@@ -57,6 +58,13 @@ void accumulate(const Snapshot& snap, int k, const TruthState& truth, ErrorSums&
     for (int a = 0; a < 3; ++a) sums.last_map_odom[a] = in.map_odom_translation[a];
     sums.has_map_odom = true;
   }
+}
+
+// The distance from a point to an axis-aligned box's footprint (0 inside).
+double box_distance(const ObstacleBox& b, double x, double y) {
+  const double dx = std::max(std::abs(x - b.x) - 0.5 * b.size_x, 0.0);
+  const double dy = std::max(std::abs(y - b.y) - 0.5 * b.size_y, 0.0);
+  return std::sqrt(dx * dx + dy * dy);
 }
 
 double yaw_of(const double q[4]) {
@@ -122,6 +130,12 @@ DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
   }
   DriveProgress prog;
   prog.duration_s = duration;
+  // A commanded drive: goals in as LCM messages through the pipeline (so
+  // a recording keeps them), commands out to the base.
+  GoalSequence goals(robot->scenario().goals, t0);
+  const int goal_input =
+      pipeline->hardware() != nullptr ? pipeline->hardware()->find_input(cfg.hardware.navigation.goal_channel.view()) : -1;
+  result.min_obstacle_distance_m = std::numeric_limits<double>::infinity();
   for (TimeNs t = t0; t <= end; t += period) {
     // Let the writer catch up: in lockstep nothing may be lost.
     while (tap && tap->recorder().backlogged()) std::this_thread::sleep_for(std::chrono::microseconds(200));
@@ -154,6 +168,22 @@ DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
     const Snapshot& snap = pipeline->core().last_snapshot();
     const TruthState truth = robot->truth_at(t);
     if (options.after_tick) options.after_tick(t, snap, truth);
+    if (robot->commanded()) {
+      // Issued at the tick; the base acts on it command_latency later, so
+      // no device has read the truth past that yet.
+      if (snap.nav.command_due && snap.nav.send_command) {
+        robot->commands().push(BaseCommand{t, snap.nav.linear_mps, snap.nav.angular_rps});
+        ++result.commands;
+      }
+      DriveGoal g;
+      if (goal_input >= 0 && goals.step(t, snap.initialized, snap.nav, truth, &g)) {
+        const std::vector<std::uint8_t> b = encode_goal(g, cfg.world_frame.c_str(), t);
+        pipeline->deliver_input(goal_input, b.data(), static_cast<int>(b.size()), t);
+      }
+    }
+    for (const ObstacleBox& b : robot->scenario().obstacles) {
+      result.min_obstacle_distance_m = std::min(result.min_obstacle_distance_m, box_distance(b, truth.x, truth.y));
+    }
     if (t >= next_truth) {
       next_truth += truth_period;
       int size = 0;
@@ -193,8 +223,19 @@ DriveResult run_sim_drive(const RuntimeConfig& cfg, const DriveOptions& options,
       progress(prog);
     }
   }
-  if (Hardware* hw = pipeline->hardware()) hw->finish_workers();
+  if (Hardware* hw = pipeline->hardware()) {
+    hw->finish_workers();
+    if (options.at_end) options.at_end(*hw);
+  }
   result.duration_s = duration;
+  result.goals = goals.outcomes();
+  result.goals_reached = goals.reached();
+  if (robot->commanded()) {
+    const SimRobot::CommandedCounters c = robot->commanded_counters();
+    result.late_commands = c.late_commands;
+    result.watchdog_stops = c.watchdog_stops;
+    result.history_misses = c.history_misses + c.far_queries + c.feed_overruns;
+  }
   for (int k = 0; k < result.num_instances; ++k) {
     InstanceErrors& e = result.instances[k];
     e.rms_error_m = e.samples > 0 ? std::sqrt(sums[k].sum_sq / static_cast<double>(e.samples)) : 0.0;

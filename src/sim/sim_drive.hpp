@@ -8,10 +8,16 @@
 #include <cstdint>
 #include <functional>
 #include <string>
+#include <vector>
 
 #include "runtime/config/config.hpp"
 #include "runtime/fusion/snapshot.hpp"
+#include "sim/goal_sequence.hpp"
 #include "sim/truth_trajectory.hpp"
+
+namespace rtfuse {
+class Hardware;
+}
 
 namespace rtfuse::sim {
 
@@ -32,6 +38,9 @@ struct DriveOptions {
   std::string trace_path;
   // Called after the loop's tick at t with what it published and the truth.
   std::function<void(TimeNs t, const Snapshot& snapshot, const TruthState& truth)> after_tick;
+  // Called once the drive is over (the workers finished) with the devices,
+  // for a tool's files of the mapper's map or the navigator's costmap.
+  std::function<void(Hardware& hardware)> at_end;
 };
 
 // One filter instance's position error against ground truth, sampled every
@@ -72,6 +81,16 @@ struct DriveResult {
   InstanceErrors instances[kMaxInstances];
   Snapshot final;
   std::int64_t recording_lost = 0;  // events the recorder had no room for (must be 0)
+  // A commanded drive: each scenario goal's fate, and the true centre's
+  // nearest approach to any [[obstacle]] box over every tick (infinity
+  // without obstacles).
+  std::vector<GoalOutcome> goals;
+  int goals_reached = 0;
+  double min_obstacle_distance_m = 0.0;
+  std::int64_t commands = 0;       // velocity commands handed to the base
+  std::int64_t late_commands = 0;  // SimRobot::commanded_counters(): must be 0 in lockstep
+  std::int64_t watchdog_stops = 0;
+  std::int64_t history_misses = 0;  // truth asked for before a reader's history (must be 0)
 };
 
 struct DriveProgress {
