@@ -23,6 +23,8 @@
 
 #include <CLI/CLI.hpp>
 
+#include "apps/mapper_files.hpp"
+#include "runtime/devices/hardware.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "sim/sim_drive.hpp"
 
@@ -100,6 +102,9 @@ int main(int argc, char** argv) {
   std::string trace_path;
   app.add_option("--trace", trace_path,
                  "write t, the truth and every instance's x y yaw (and map -> odom) at 50 Hz to this CSV file");
+  std::string map_out;
+  app.add_option("--map-out", map_out,
+                 "write the mapper's map at the end: PREFIX.bt, PREFIX.pgm + PREFIX.yaml and PREFIX.png");
   app.add_flag("-q,--quiet", quiet, "no progress line");
   app.add_option("--report-every", report_every, "a JSON line every S simulated seconds (the soak; 0: none)")
       ->check(CLI::NonNegativeNumber);
@@ -128,6 +133,17 @@ int main(int argc, char** argv) {
   options.scenario_path = scenario_path;
   options.record_path = out_path;
   options.config_text = text;
+  std::string map_error;
+  if (!map_out.empty()) {
+    if (!cfg.hardware.mapping.enabled) {
+      std::fprintf(stderr, "rtfuse-sim: --map-out needs a [mapping] section in %s\n", config_path.c_str());
+      return 2;
+    }
+    options.at_end = [&](rtfuse::Hardware& hw) {
+      rtfuse::MapperDevice* mapper = hw.find<rtfuse::MapperDevice>("mapper");
+      if (mapper != nullptr) rtfuse::apps::write_mapper_files(*mapper, map_out, "rtfuse-sim: the map at the end", &map_error);
+    };
+  }
   options.trace_path = trace_path;
   SoakReport soak;
   soak.every_s = report_every;
@@ -148,6 +164,10 @@ int main(int argc, char** argv) {
   if (tty) std::fprintf(stderr, "\n");
   if (!r.ok) {
     std::fprintf(stderr, "rtfuse-sim: %s\n", r.error.c_str());
+    return 1;
+  }
+  if (!map_error.empty()) {
+    std::fprintf(stderr, "rtfuse-sim: the map's files: %s\n", map_error.c_str());
     return 1;
   }
   if (r.recording_lost > 0) {
@@ -173,6 +193,24 @@ int main(int argc, char** argv) {
                 e.rms_error_m, e.final_yaw_error_rad, e.max_error_m, e.max_jump_m, e.max_map_odom_step_m,
                 s.instances[k].fixes_fused);
   }
-  std::printf("}}\n");
+  std::printf("}");
+  if (!r.goals.empty()) {
+    // A commanded drive: what became of each goal, the true nearest
+    // approach to an obstacle, and whether the base's readers agreed.
+    std::printf(", \"goals_reached\": %d, \"min_obstacle_distance_m\": %.4f, \"commands\": %" PRId64
+                ", \"late_commands\": %" PRId64 ", \"watchdog_stops\": %" PRId64 ", \"truth_misses\": %" PRId64
+                ", \"goals\": [",
+                r.goals_reached, r.min_obstacle_distance_m, r.commands, r.late_commands, r.watchdog_stops,
+                r.history_misses);
+    for (std::size_t i = 0; i < r.goals.size(); ++i) {
+      const rtfuse::sim::GoalOutcome& g = r.goals[i];
+      std::printf("%s{\"sent\": %s, \"reached\": %s, \"rejected\": %s, \"error_m\": %.4f, \"sent_s\": %.2f, "
+                  "\"done_s\": %.2f, \"why\": \"%s\"}",
+                  i ? ", " : "", g.sent ? "true" : "false", g.reached ? "true" : "false",
+                  g.rejected ? "true" : "false", g.truth_error_m, g.sent_s, g.done_s, g.why.c_str());
+    }
+    std::printf("]");
+  }
+  std::printf("}\n");
   return 0;
 }

@@ -13,12 +13,14 @@
 #include <cerrno>
 #include <cstdio>
 #include <cstring>
+#include <memory>
 #include <string>
 #include <thread>
+#include <vector>
 
 #include <CLI/CLI.hpp>
 
-#include "apps/map_outputs.hpp"
+#include "apps/mapper_files.hpp"
 #include "hal/linux/monotonic_clock.hpp"
 #include "mapping/map_digest.hpp"
 #include "runtime/devices/mapper/mapper_device.hpp"
@@ -28,6 +30,8 @@
 #include "runtime/live/loop_timer.hpp"
 #include "runtime/live/realtime.hpp"
 #include "runtime/live/runtime.hpp"
+#include "rtfuse/twist_stamped_t.hpp"
+#include "sim/goal_sequence.hpp"
 #include "sim/ground_truth.hpp"
 #include "sim/sim_lcm_robot.hpp"
 #include "sim/sim_robot.hpp"
@@ -63,56 +67,37 @@ void sim_thread(rtfuse::sim::SimLcmRobot* sim, rtfuse::transport::LcmNode* lcm, 
   }
 }
 
-// Ground truth of the bus-level simulated robot onto LCM, at 50 Hz.
+// A commanded simulated base hears rtfuse/cmd_vel as a robot's base would:
+// on the LCM thread, into its command feed, issued when it arrived.
+struct CommandListener {
+  rtfuse::sim::SimRobot* robot = nullptr;
+  rtfuse::twist_stamped_t msg{};  // kept: decoding reuses its string's capacity
+};
+
+void on_cmd_vel(const char*, const std::uint8_t* data, int size, std::int64_t, void* user) {
+  auto* c = static_cast<CommandListener*>(user);
+  if (c->msg.decode(data, 0, size) != size) return;
+  c->robot->commands().push({rtfuse::monotonic_now_ns(), c->msg.twist.linear.x, c->msg.twist.angular.z});
+}
+
+// Ground truth of the bus-level simulated robot onto LCM, at 50 Hz; a
+// commanded robot's through a truth reader of this thread's own.
 void truth_thread(rtfuse::sim::SimRobot* robot, rtfuse::transport::LcmNode* lcm, std::atomic<bool>* run) {
   rtfuse::name_this_thread("rtfuse-sim");
+  std::unique_ptr<rtfuse::sim::CommandedTruth> reader = robot->make_truth_reader();
   rtfuse::sim::GroundTruthEncoder encoder;
   rtfuse::TimeNs next = rtfuse::monotonic_now_ns();
   while (run->load(std::memory_order_relaxed)) {
     next += 20'000'000;
     rtfuse::sleep_until(next);
     int size = 0;
-    const std::uint8_t* bytes = encoder.encode(robot->truth_at(next), next, &size);
+    const rtfuse::sim::TruthState truth =
+        reader ? reader->truth_at(rtfuse::ns_to_sec(next - robot->start_time())) : robot->truth_at(next);
+    const std::uint8_t* bytes = encoder.encode(truth, next, &size);
     if (size > 0) lcm->publish(rtfuse::sim::kGroundTruthChannel, bytes, size);
   }
 }
 
-
-// The mapper's files at exit ([mapping] output or --map-out): the map as
-// it ended, the grid, and the keyframes' path over it. False with the reason.
-bool write_map_files(rtfuse::MapperDevice& mapper, const std::string& prefix, std::string* error) {
-  rtfuse::apps::MapOutputs out;
-  out.prefix = prefix;
-  out.title = "rtfused: the map at exit";
-  for (int i = 0; i < mapper.trajectory_size(); ++i) {
-    out.path.push_back({mapper.trajectory()[i].x, mapper.trajectory()[i].y});
-  }
-  const rtfuse::MapperStats s = mapper.stats();
-  const rtfuse::mapping::OccupancyMap& map = mapper.map();
-  char line[160];
-  out.figures.push_back("# the map");
-  std::snprintf(line, sizeof line, "keyframes   %lld (%lld dropped)", static_cast<long long>(s.inserted),
-                static_cast<long long>(mapper.dropped()));
-  out.figures.push_back(line);
-  std::snprintf(line, sizeof line, "voxels      %.2f cm, range %.1f m", mapper.config().resolution_m * 100.0,
-                mapper.config().max_range_m);
-  out.figures.push_back(line);
-  std::snprintf(line, sizeof line, "known       %llu", static_cast<unsigned long long>(map.known_voxels()));
-  out.figures.push_back(line);
-  std::snprintf(line, sizeof line, "occupied    %llu", static_cast<unsigned long long>(map.occupied_voxels()));
-  out.figures.push_back(line);
-  std::snprintf(line, sizeof line, "memory      %.2f MB", static_cast<double>(map.store().bytes_used()) / 1e6);
-  out.figures.push_back(line);
-  std::snprintf(line, sizeof line, "digest      %016llx",
-                static_cast<unsigned long long>(rtfuse::mapping::map_digest(map)));
-  out.figures.push_back(line);
-  out.figures.push_back("");
-  out.figures.push_back("# the grid");
-  std::snprintf(line, sizeof line, "heights     %.2f to %.2f m", mapper.config().grid_min_z_m,
-                mapper.config().grid_max_z_m);
-  out.figures.push_back(line);
-  return rtfuse::apps::write_map_outputs(map, mapper.grid_spec(), mapper.grid_cells(), out, error);
-}
 
 }  // namespace
 
@@ -240,6 +225,21 @@ int main(int argc, char** argv) {
                sim ? ", LCM-level simulated robot" : "", robot ? ", bus-level simulated robot" : "",
                record_path.empty() ? "" : (", recording to " + record_path).c_str());
 
+  // A commanded drive: the base follows rtfuse/cmd_vel, and the scenario's
+  // goals go out on the goal channel one after the other, as an operator
+  // would send them.
+  CommandListener listener;
+  std::unique_ptr<rtfuse::sim::GoalSequence> goals;
+  if (robot && robot->commanded()) {
+    listener.robot = robot.get();
+    listener.msg.header.frame_id.reserve(256);
+    if (!runtime->lcm().subscribe(cfg.hardware.navigation.cmd_vel_channel.c_str(), on_cmd_vel, &listener)) {
+      std::fprintf(stderr, "rtfused: cannot subscribe to %s\n", cfg.hardware.navigation.cmd_vel_channel.c_str());
+      return 1;
+    }
+    goals = std::make_unique<rtfuse::sim::GoalSequence>(robot->goals(), robot->start_time());
+  }
+
   std::atomic<bool> sim_run{true};
   std::thread sim_worker;
   if (sim) sim_worker = std::thread(sim_thread, sim.get(), &runtime->lcm(), &sim_run);
@@ -280,6 +280,13 @@ int main(int argc, char** argv) {
                    "(rtfuse-replay --allow-truncated)\n",
                    record_path.c_str(), rtfuse::ns_to_sec(now - start), why.c_str());
       recording_failure_said = true;
+    }
+    rtfuse::sim::DriveGoal goal;
+    if (goals && goals->step(now, s.initialized, s.nav, robot->truth_at(now), &goal)) {
+      const std::vector<std::uint8_t> b = rtfuse::sim::encode_goal(goal, cfg.world_frame.c_str(), now);
+      runtime->lcm().publish(cfg.hardware.navigation.goal_channel.c_str(), b.data(), static_cast<int>(b.size()));
+      std::fprintf(stderr, "%srtfused: goal %d of %zu: (%.2f, %.2f)\n", tty && !quiet ? "\n" : "", goals->current() + 1,
+                   robot->goals().size(), goal.x_m, goal.y_m);
     }
     if ((sim || robot) && s.initialized) {
       double tx = 0.0, ty = 0.0;
@@ -360,6 +367,16 @@ int main(int argc, char** argv) {
     if (!d.message.empty()) std::printf("; last error: %s", d.message.c_str());
     std::printf("\n");
   }
+  if (goals) {
+    int i = 0;
+    for (const rtfuse::sim::GoalOutcome& g : goals->outcomes()) {
+      ++i;
+      if (!g.sent) continue;
+      std::printf("rtfused: goal %d: %s, %.3f m from it (truth)%s%s\n", i,
+                  g.reached ? "reached" : g.rejected ? "refused" : "not reached", g.truth_error_m,
+                  g.why.empty() ? "" : ": ", g.why.c_str());
+    }
+  }
   if ((sim || robot) && err_samples > 0) {
     std::printf("rtfused: position error against ground truth: final %.3f m, RMS %.3f m over %ld samples\n",
                 last_error, std::sqrt(err_sq_sum / err_samples), err_samples);
@@ -375,7 +392,7 @@ int main(int argc, char** argv) {
       runtime->hardware() != nullptr ? runtime->hardware()->find<rtfuse::MapperDevice>("mapper") : nullptr;
   if (mapper != nullptr && !cfg.hardware.mapping.output.empty()) {
     const std::string& prefix = cfg.hardware.mapping.output;
-    if (!write_map_files(*mapper, prefix, &error)) {
+    if (!rtfuse::apps::write_mapper_files(*mapper, prefix, "rtfused: the map at exit", &error)) {
       std::fprintf(stderr, "rtfused: the map's files: %s\n", error.c_str());
       return 1;
     }
