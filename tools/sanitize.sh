@@ -58,9 +58,12 @@ case "$kind" in
     # drives, the mapper's and the live recording. And the map's accuracy on
     # the obstacle course (50 s here): it scores depth and map against the
     # world's truth; its renderer, matcher and map run here in the rendered
-    # pairs' tests and the mapper's lockstep drive.
+    # pairs' tests and the mapper's lockstep drive. And the navigator's
+    # closed loop (30 s natively, minutes here): its navigator runs here in
+    # its own unit tests and in the daemon fuzzer, its drive in the
+    # mapper's and the commanded base's lockstep drives.
     (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference \
-      -E '^(integration_gnss_drive|integration_camera_slip|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth)$' "$@")
+      -E '^(integration_gnss_drive|integration_camera_slip|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays)$' "$@")
     ;;
   tsan)
     build_tsan
@@ -72,10 +75,12 @@ case "$kind" in
     # and its odometry take some 0.2 s, so config/sim.toml's camera runs at
     # 15 fps and its odometry restarts only after 2 s without a pair;
     # otherwise it would restart at every pair and never push a twist.
-    # Its mapper takes a keyframe a second (one takes some 0.5 s here).
+    # Its mapper takes a keyframe a second (one takes some 0.5 s here), and
+    # the navigator's thread takes its grids (no goal: the drive is scripted).
     sed -e 's/^fps = 30$/fps = 15/' -e 's/^max_interval = 0.25 .*/max_interval = 2.0/' \
       -e 's/^keyframe_interval = 0.2 /keyframe_interval = 1.0 /' \
       "$root/config/sim.toml" >"$dir/sim_tsan.toml"
+    printf '\n[navigation]\n' >>"$dir/sim_tsan.toml"
     ln -sfn "$root/config/calibration" "$dir/calibration"
     ln -sfn "$root/config/scenarios" "$dir/scenarios"
     echo "sanitize.sh: rtfused under ThreadSanitizer, 8 s on the simulated robot"
