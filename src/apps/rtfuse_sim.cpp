@@ -23,9 +23,13 @@
 
 #include <CLI/CLI.hpp>
 
+
 #include "apps/mapper_files.hpp"
-#include "runtime/devices/hardware.hpp"
+#include "apps/nav_figure.hpp"
 #include "runtime/config/config_loader.hpp"
+#include "runtime/devices/hardware.hpp"
+#include "runtime/devices/navigator/navigator_device.hpp"
+#include "sim/drive_scenario.hpp"
 #include "sim/sim_drive.hpp"
 
 extern "C" void rtfuse_alloc_probe_steady(int steady) __attribute__((weak));
@@ -102,7 +106,9 @@ int main(int argc, char** argv) {
   std::string trace_path;
   app.add_option("--trace", trace_path,
                  "write t, the truth and every instance's x y yaw (and map -> odom) at 50 Hz to this CSV file");
-  std::string map_out;
+  std::string map_out, nav_out;
+  app.add_option("--nav-out", nav_out,
+                 "write the navigator's costmap, its last path, the truly driven trajectory and the goals as a PNG");
   app.add_option("--map-out", map_out,
                  "write the mapper's map at the end: PREFIX.bt, PREFIX.pgm + PREFIX.yaml and PREFIX.png");
   app.add_flag("-q,--quiet", quiet, "no progress line");
@@ -134,25 +140,47 @@ int main(int argc, char** argv) {
   options.record_path = out_path;
   options.config_text = text;
   std::string map_error;
-  if (!map_out.empty()) {
-    if (!cfg.hardware.mapping.enabled) {
-      std::fprintf(stderr, "rtfuse-sim: --map-out needs a [mapping] section in %s\n", config_path.c_str());
-      return 2;
-    }
-    options.at_end = [&](rtfuse::Hardware& hw) {
-      rtfuse::MapperDevice* mapper = hw.find<rtfuse::MapperDevice>("mapper");
-      if (mapper != nullptr) rtfuse::apps::write_mapper_files(*mapper, map_out, "rtfuse-sim: the map at the end", &map_error);
-    };
+  if (!map_out.empty() && !cfg.hardware.mapping.enabled) {
+    std::fprintf(stderr, "rtfuse-sim: --map-out needs a [mapping] section in %s\n", config_path.c_str());
+    return 2;
   }
+  if (!nav_out.empty() && !cfg.hardware.navigation.enabled) {
+    std::fprintf(stderr, "rtfuse-sim: --nav-out needs a [navigation] section in %s\n", config_path.c_str());
+    return 2;
+  }
+  rtfuse::apps::NavFigure nav_figure;
+  std::vector<std::uint8_t> nav_costs;
+  options.at_end = [&](rtfuse::Hardware& hw) {
+    rtfuse::MapperDevice* mapper = hw.find<rtfuse::MapperDevice>("mapper");
+    if (mapper != nullptr && !map_out.empty()) {
+      rtfuse::apps::write_mapper_files(*mapper, map_out, "rtfuse-sim: the map at the end", &map_error);
+    }
+    rtfuse::NavigatorDevice* nav = hw.find<rtfuse::NavigatorDevice>("planner");
+    if (nav != nullptr && !nav_out.empty()) {
+      const rtfuse::navigation::CostView v = nav->costmap().view();
+      nav_costs.assign(v.cost, v.cost + static_cast<std::size_t>(v.width) * static_cast<std::size_t>(v.height));
+      nav_figure.costs = nav_costs.data();
+      nav_figure.width = v.width;
+      nav_figure.height = v.height;
+      nav_figure.resolution = nav->layout().resolution_m;
+      nav_figure.origin_x = nav->layout().origin_x;
+      nav_figure.origin_y = nav->layout().origin_y;
+      const rtfuse::navigation::PathFollower& f = nav->follower();
+      for (int i = 0; i < f.path_size(); ++i) nav_figure.path.push_back({f.path()[i].x, f.path()[i].y});
+    }
+  };
   options.trace_path = trace_path;
   SoakReport soak;
   soak.every_s = report_every;
   soak.next_s = report_every;
   rtfuse::TimeNs t0 = -1;
-  if (report_every > 0) {
+  std::int64_t ticks_seen = 0;
+  if (report_every > 0 || !nav_out.empty()) {
     options.after_tick = [&](rtfuse::TimeNs t, const rtfuse::Snapshot& s, const rtfuse::sim::TruthState& truth) {
       if (t0 < 0) t0 = t;
-      soak.on_tick(t, t0, s, truth);
+      if (report_every > 0) soak.on_tick(t, t0, s, truth);
+      // The driven trajectory, 20 points a second of a 200 Hz loop.
+      if (!nav_out.empty() && ticks_seen++ % 10 == 0) nav_figure.driven.push_back({truth.x, truth.y});
     };
   }
   const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
@@ -165,6 +193,43 @@ int main(int argc, char** argv) {
   if (!r.ok) {
     std::fprintf(stderr, "rtfuse-sim: %s\n", r.error.c_str());
     return 1;
+  }
+  if (!nav_out.empty() && nav_figure.costs != nullptr) {
+    nav_figure.title = "rtfuse-sim: the costmap, the last path and the drive";
+    std::string scenario_error;
+    rtfuse::sim::DriveScenario scenario;
+    const std::string scenario_file = scenario_path.empty() ? cfg.hardware.scenario : scenario_path;
+    if (rtfuse::sim::load_drive_scenario(scenario_file, &scenario, &scenario_error)) {
+      for (const rtfuse::sim::ObstacleBox& b : scenario.obstacles) {
+        nav_figure.obstacles.push_back(
+            {b.x - 0.5 * b.size_x, b.y - 0.5 * b.size_y, b.x + 0.5 * b.size_x, b.y + 0.5 * b.size_y});
+      }
+      for (const rtfuse::sim::DriveGoal& g : scenario.goals) nav_figure.goals.push_back({g.x_m, g.y_m});
+    }
+    char line[160];
+    nav_figure.figures.push_back("# the drive");
+    std::snprintf(line, sizeof line, "time        %.0f s", r.duration_s);
+    nav_figure.figures.push_back(line);
+    std::snprintf(line, sizeof line, "goals       %d of %zu reached", r.goals_reached, r.goals.size());
+    nav_figure.figures.push_back(line);
+    double worst = 0.0;
+    for (const rtfuse::sim::GoalOutcome& g : r.goals) {
+      if (g.reached) worst = std::max(worst, g.truth_error_m);
+    }
+    std::snprintf(line, sizeof line, "worst goal  %.2f m (truth)", worst);
+    nav_figure.figures.push_back(line);
+    std::snprintf(line, sizeof line, "closest     %.2f m to an obstacle", r.min_obstacle_distance_m);
+    nav_figure.figures.push_back(line);
+    std::snprintf(line, sizeof line, "plans       %lld, %lld re-plans blocked",
+                  static_cast<long long>(r.final.nav.plans), static_cast<long long>(r.final.nav.replans_blocked));
+    nav_figure.figures.push_back(line);
+    std::snprintf(line, sizeof line, "estimate    %.2f m RMS error", r.rms_error_m);
+    nav_figure.figures.push_back(line);
+    std::string nav_error;
+    if (!rtfuse::apps::write_nav_png(nav_figure, nav_out, &nav_error)) {
+      std::fprintf(stderr, "rtfuse-sim: %s\n", nav_error.c_str());
+      return 1;
+    }
   }
   if (!map_error.empty()) {
     std::fprintf(stderr, "rtfuse-sim: the map's files: %s\n", map_error.c_str());
@@ -210,6 +275,17 @@ int main(int argc, char** argv) {
                   g.rejected ? "true" : "false", g.truth_error_m, g.sent_s, g.done_s, g.why.c_str());
     }
     std::printf("]");
+    // The navigator's counters as diagnostics_t has them (plans, their
+    // time, re-plans, the costmap's time).
+    for (int i = 0; i < s.num_devices; ++i) {
+      const rtfuse::DeviceStatus& d = s.devices[i];
+      if (std::strcmp(d.name.c_str(), "navigator") != 0) continue;
+      std::printf(", \"navigator\": {");
+      for (int k = 0; k < d.num_values; ++k) {
+        std::printf("%s\"%s\": %lld", k ? ", " : "", d.keys[k], static_cast<long long>(d.values[k]));
+      }
+      std::printf("}");
+    }
   }
   std::printf("}\n");
   return 0;

@@ -35,8 +35,11 @@ std::vector<std::uint8_t> encode_goal(const DriveGoal& goal, const char* frame, 
 class GoalSequence {
  public:
   // The goals (none: nothing is ever sent). The first goes out once the
-  // estimate is initialised and `settle_s` of the drive have passed.
-  GoalSequence(const std::vector<DriveGoal>& goals, TimeNs t0, double settle_s = 1.0);
+  // estimate is initialised and `settle_s` of the drive have passed: as a
+  // robot is left standing at power-up, so the IMU learns its gyro bias at
+  // standstill (its 2 s time constant and 0.5 s window) before the first
+  // slow turn, which it would otherwise learn as a bias at full pace.
+  GoalSequence(const std::vector<DriveGoal>& goals, TimeNs t0, double settle_s = 3.0);
 
   // After the tick at t: true when a goal is to be sent now (*goal).
   bool step(TimeNs t, bool estimate_initialized, const NavSnapshot& nav, const TruthState& truth,
