@@ -113,7 +113,9 @@ show() { # show FILE TITLE: a file's content, indented, for the CTest log
   sed 's/^/  /' "$1"
 }
 
-# record LOG: lcm-logger for ~5 s while rtfused runs 6 s; sets rtfused_rc
+# record LOG: lcm-logger for ~5 s while rtfused runs 6 s (with the
+# arguments in rtfused_args); sets rtfused_rc
+rtfused_args=()
 record() {
   local log=$1
   command -v lcm-logger >/dev/null || die "lcm-logger not found (package liblcm-bin)"
@@ -123,7 +125,7 @@ record() {
   sleep 0.5
   kill -0 "$logger" 2>/dev/null || { show "$outdir/lcm-logger.out" lcm-logger; die "lcm-logger did not start"; }
 
-  timeout -k 5 25 "$rtfused" --duration 6 --lcm-url "$URL" \
+  timeout -k 5 25 "$rtfused" --duration 6 --lcm-url "$URL" "${rtfused_args[@]}" \
     >"$outdir/rtfused.stdout" 2>"$outdir/rtfused.stderr" &
   local daemon=$!
   pids+=("$daemon")
@@ -141,12 +143,16 @@ record() {
   [[ -f "$log" ]] || die "lcm-logger wrote no log"
 }
 
+# The grid's rate: 1 Hz of capture time, measured over the three or four
+# grids of a 5 s log (wider with the navigator: config/sim_nav.toml's grid
+# is 24 m across and its mapper shares two cores with the planner).
+map_rate=0.7:1.3
 check_log() {
   "$PYTHON" "$CHECK" log "$1" --rtfused-rc "$rtfused_rc" --rtfused-stdout "$outdir/rtfused.stdout" \
     --expect rtfuse/odometry:101 --expect rtfuse/pose:101 --expect rtfuse/tf:101 \
     --expect rtfuse/state:21 --expect rtfuse/diagnostics:3 --expect rtfuse/map:3 \
     --rate rtfuse/odometry:35:65 --rate rtfuse/pose:35:65 --rate rtfuse/tf:35:65 --rate rtfuse/state:7:13 \
-    --rate rtfuse/map:0.7:1.3
+    --rate "rtfuse/map:$map_rate"
 }
 
 case "$mode" in
@@ -156,6 +162,11 @@ case "$mode" in
     ;;
 
   jvm_decode)
+    # The robot that drives itself (config/sim_nav.toml): its first goal at
+    # 3 s, so the log also holds a path, commands and the navigator's status.
+    [[ -f "$CONFIG_DIR/sim_nav.toml" ]] || die "no config/sim_nav.toml under CONFIG_DIR=$CONFIG_DIR"
+    rtfused_args=(--config "$CONFIG_DIR/sim_nav.toml")
+    map_rate=0.4:1.3
     record "$outdir/jvm_decode.lcm"
     check_log "$outdir/jvm_decode.lcm" >"$outdir/check_log.out" 2>&1 || {
       cat "$outdir/check_log.out"
@@ -166,7 +177,10 @@ case "$mode" in
             rtfuse/tf=rtfuse.tf_t:101
             rtfuse/state=rtfuse.filter_state_t:21
             rtfuse/diagnostics=rtfuse.diagnostics_t:3
-            rtfuse/map=rtfuse.occupancy_grid_t:3)
+            rtfuse/map=rtfuse.occupancy_grid_t:3
+            rtfuse/path=rtfuse.path_t:1
+            rtfuse/cmd_vel=rtfuse.twist_stamped_t:50
+            rtfuse/nav_status=rtfuse.nav_status_t:50)
     decode() { CLASSPATH= "$JAVA" -Djava.awt.headless=true -cp "$CLASSPATH_DECODE" DecodeAll "$@"; }
     say "decoding every rtfuse/* event with the generated Java classes"
     decode "$outdir/jvm_decode.lcm" "${expect[@]}" || die "the JVM could not decode the log"
