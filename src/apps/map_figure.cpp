@@ -3,20 +3,21 @@
 #include <algorithm>
 #include <cmath>
 
+#include "apps/grid_figure.hpp"
 #include "apps/legend.hpp"
 
 namespace rtfuse::apps {
 namespace {
 
-constexpr int kScale = 2;
+constexpr int kScale = kGridFigureScale;
 constexpr Rgb kWhite{255, 255, 255};
 constexpr Rgb kInk{0, 0, 0};
 constexpr Rgb kOccupied{0, 0, 0};
 constexpr Rgb kFree{254, 254, 254};
 constexpr Rgb kUnknown{205, 205, 205};
 constexpr Rgb kPath{220, 40, 40};
-constexpr Rect kView{110, 80, 760, 760};
-constexpr int kColumnX = 930;
+constexpr Rect kView = kGridFigureView;
+constexpr int kColumnX = kGridFigureColumnX;
 
 }  // namespace
 
@@ -38,21 +39,15 @@ bool write_map_png(const MapFigure& f, const std::string& path, std::string* err
   options.y_title = "y [m]";
   const Axes axes(kView, xr, yr, options);
   axes.draw_grid(canvas);
-  // Each cell a rectangle from its corners' pixels: cells of a fraction of
-  // a pixel fall on the same pixel, occupied drawn last so it shows.
+  // Occupied drawn last, so it shows where cells share a pixel.
   canvas.set_clip(axes.area());
+  const GridPlacement placement{f.origin_x, f.origin_y, f.resolution};
   for (const std::int8_t state : {std::int8_t{0}, std::int8_t{-1}, std::int8_t{100}}) {
     const Rgb colour = state == 100 ? kOccupied : state == 0 ? kFree : kUnknown;
     for (int j = 0; j < f.height; ++j) {
       for (int i = 0; i < f.width; ++i) {
         if (f.cells[static_cast<std::size_t>(j) * static_cast<std::size_t>(f.width) + i] != state) continue;
-        const PointPx a = axes.to_px({f.origin_x + i * f.resolution, f.origin_y + j * f.resolution});
-        const PointPx b = axes.to_px({f.origin_x + (i + 1) * f.resolution, f.origin_y + (j + 1) * f.resolution});
-        const int x0 = static_cast<int>(std::floor(std::min(a.x, b.x)));
-        const int y0 = static_cast<int>(std::floor(std::min(a.y, b.y)));
-        const int x1 = std::max(x0 + 1, static_cast<int>(std::floor(std::max(a.x, b.x))));
-        const int y1 = std::max(y0 + 1, static_cast<int>(std::floor(std::max(a.y, b.y))));
-        canvas.fill_rect({x0, y0, x1 - x0, y1 - y0}, colour);
+        fill_grid_cell(canvas, axes, placement, i, j, colour);
       }
     }
   }

@@ -3,12 +3,13 @@
 #include <algorithm>
 #include <cmath>
 
+#include "apps/grid_figure.hpp"
 #include "apps/legend.hpp"
 
 namespace rtfuse::apps {
 namespace {
 
-constexpr int kNavScale = 2;
+constexpr int kNavScale = kGridFigureScale;
 constexpr Rgb kNavWhite{255, 255, 255};
 constexpr Rgb kNavInk{0, 0, 0};
 constexpr Rgb kLethal{0, 0, 0};
@@ -18,8 +19,8 @@ constexpr Rgb kTruthBox{0, 150, 60};
 constexpr Rgb kPlanned{30, 90, 220};
 constexpr Rgb kDriven{220, 40, 40};
 constexpr Rgb kGoal{230, 140, 0};
-constexpr Rect kNavView{110, 80, 760, 760};
-constexpr int kNavColumnX = 930;
+constexpr Rect kNavView = kGridFigureView;
+constexpr int kNavColumnX = kGridFigureColumnX;
 
 // Inflation from white (0) to a full rose (252), as costmap_2d's viewers shade it.
 Rgb cost_colour(std::uint8_t c) noexcept {
@@ -67,19 +68,13 @@ bool write_nav_png(const NavFigure& f, const std::string& path, std::string* err
   axes.draw_grid(canvas);
   canvas.set_clip(axes.area());
   // Low costs first, so the higher ones of cells sharing a pixel show.
+  const GridPlacement placement{f.origin_x, f.origin_y, f.resolution};
   for (int pass = 0; pass < 2; ++pass) {
     for (int j = 0; j < f.height; ++j) {
       for (int i = 0; i < f.width; ++i) {
         const std::uint8_t c = f.costs[static_cast<std::size_t>(j) * static_cast<std::size_t>(f.width) + i];
-        if ((pass == 0) != (c < 253 || c == 255)) continue;
-        if (c == 0) continue;
-        const PointPx a = axes.to_px({f.origin_x + i * f.resolution, f.origin_y + j * f.resolution});
-        const PointPx b = axes.to_px({f.origin_x + (i + 1) * f.resolution, f.origin_y + (j + 1) * f.resolution});
-        const int x0 = static_cast<int>(std::floor(std::min(a.x, b.x)));
-        const int y0 = static_cast<int>(std::floor(std::min(a.y, b.y)));
-        const int x1 = std::max(x0 + 1, static_cast<int>(std::floor(std::max(a.x, b.x))));
-        const int y1 = std::max(y0 + 1, static_cast<int>(std::floor(std::max(a.y, b.y))));
-        canvas.fill_rect({x0, y0, x1 - x0, y1 - y0}, cost_colour(c));
+        if ((pass == 0) != (c < 253 || c == 255) || c == 0) continue;
+        fill_grid_cell(canvas, axes, placement, i, j, cost_colour(c));
       }
     }
   }

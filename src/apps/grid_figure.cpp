@@ -1,0 +1,18 @@
+#include "apps/grid_figure.hpp"
+
+#include <algorithm>
+#include <cmath>
+
+namespace rtfuse::apps {
+
+void fill_grid_cell(Canvas& canvas, const Axes& axes, const GridPlacement& g, int i, int j, Rgb colour) {
+  const PointPx a = axes.to_px({g.origin_x + i * g.resolution, g.origin_y + j * g.resolution});
+  const PointPx b = axes.to_px({g.origin_x + (i + 1) * g.resolution, g.origin_y + (j + 1) * g.resolution});
+  const int x0 = static_cast<int>(std::floor(std::min(a.x, b.x)));
+  const int y0 = static_cast<int>(std::floor(std::min(a.y, b.y)));
+  const int x1 = std::max(x0 + 1, static_cast<int>(std::floor(std::max(a.x, b.x))));
+  const int y1 = std::max(y0 + 1, static_cast<int>(std::floor(std::max(a.y, b.y))));
+  canvas.fill_rect({x0, y0, x1 - x0, y1 - y0}, colour);
+}
+
+}  // namespace rtfuse::apps
