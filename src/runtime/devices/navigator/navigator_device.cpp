@@ -156,15 +156,17 @@ void NavigatorDevice::on_input(int channel, const std::uint8_t* data, int size, 
 // --- mapper thread -------------------------------------------------------------
 
 void NavigatorDevice::on_grid(const std::int8_t* cells, TimeNs stamp) noexcept {
-  int slot = -1;
-  if (!free_grids_.try_pop(slot)) {
+  int slot = spare_grid_;
+  spare_grid_ = -1;
+  if (slot < 0 && !free_grids_.try_pop(slot)) {
     grids_dropped_.fetch_add(1, std::memory_order_relaxed);
     return;
   }
   std::memcpy(grid_slots_[slot].get(), cells,
               static_cast<std::size_t>(layout_.width) * static_cast<std::size_t>(layout_.height));
   if (!grid_notes_.try_push(GridNote{stamp, slot})) {
-    free_grids_.try_push(slot);
+    // Kept on this side: the free ring has one producer, the navigator.
+    spare_grid_ = slot;
     grids_dropped_.fetch_add(1, std::memory_order_relaxed);
   }
 }
@@ -376,7 +378,8 @@ void NavigatorDevice::send(Result r) noexcept {
   r.apply_at = r.time + plan_delay_ns_;
   if (!results_.try_push(r)) {
     lost_.fetch_add(1, std::memory_order_relaxed);
-    if (r.slot >= 0) free_paths_.try_push(r.slot);
+    // Kept on this side: the free ring has one producer, the loop.
+    if (r.slot >= 0) spare_path_ = r.slot;
   }
 }
 
@@ -424,7 +427,10 @@ void NavigatorDevice::plan_and_send(TimeNs t, const LoopPose& from, PlanCause ca
   stats_.max_plan_ns = std::max(stats_.max_plan_ns, t1 - t0);
   res.status = pr.status;
   int slot = -1;
-  if (pr.ok() && !free_paths_.try_pop(slot)) {
+  if (pr.ok() && spare_path_ >= 0) {
+    slot = spare_path_;
+    spare_path_ = -1;
+  } else if (pr.ok() && !free_paths_.try_pop(slot)) {
     // Every path slot is waiting for the loop: it has stopped taking
     // results, so this one would not be taken either.
     res.status = navigation::PlanStatus::kPathTooLong;

@@ -196,7 +196,8 @@ class NavigatorDevice final : public Device, public GridConsumer {
 
   // Mapper thread -> navigator thread.
   std::unique_ptr<std::int8_t[]> grid_slots_[kGridSlots];
-  SpscRing<int> free_grids_{kGridSlots + 1};
+  SpscRing<int> free_grids_{kGridSlots + 1};  // the navigator returns, the mapper takes
+  int spare_grid_ = -1;  // mapper thread: a slot whose note the ring refused, kept for the next
   SpscRing<GridNote> grid_notes_{256};
   std::atomic<std::int64_t> grids_dropped_{0};
 
@@ -209,7 +210,8 @@ class NavigatorDevice final : public Device, public GridConsumer {
 
   // Navigator thread -> loop.
   std::unique_ptr<navigation::Point2[]> path_slots_[kPathSlots];
-  SpscRing<int> free_paths_{kPathSlots + 1};
+  SpscRing<int> free_paths_{kPathSlots + 1};  // the loop returns, the navigator takes
+  int spare_path_ = -1;  // navigator thread: a slot whose result the ring refused, kept for the next
   SpscRing<Result> results_{256};
 
   // Navigator thread.
