@@ -32,8 +32,8 @@ std::string read_file(const std::string& path) {
 
 // obstacle_goals.toml's robot, base and IMU with one wall 3 m ahead, 2.4 m
 // wide, and one goal 3 m behind it: the straight line runs into the wall's
-// middle, and the way round is 1.2 m to either side. It arrives after some
-// 24 s.
+// middle, and the way round is 1.2 m to either side. The first goal goes
+// out after 3 s of standstill and is reached after some 33 s.
 std::string wall_scenario() {
   std::string text = read_file(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacle_goals.toml");
   const std::size_t goals = text.find("\n[[goal]]");
@@ -47,7 +47,7 @@ std::string wall_scenario() {
   const std::string from = "duration_s = 240.0";
   const std::size_t at = text.find(from);
   EXPECT_NE(at, std::string::npos);
-  text.replace(at, from.size(), "duration_s = 27.0");
+  text.replace(at, from.size(), "duration_s = 36.0");
   const std::string path = testing::TempDir() + "rtfuse_nav_wall_" + std::to_string(::getpid()) + ".toml";
   std::ofstream(path) << text;
   return path;
