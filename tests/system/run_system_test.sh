@@ -37,6 +37,12 @@ set -euo pipefail
 
 SKIP=77
 URL='udpm://239.255.76.67:7667?ttl=0'
+# The logger's socket gets a receive buffer that holds whole grids:
+# config/sim_nav.toml's 24 m grid is a 230 kB message, larger than the
+# kernel's default 208 kB (rmem_default), so under load the logger lost
+# fragments and with them whole grids (LCM warns "receive buffer is very
+# small"). The kernel caps the request at net.core.rmem_max.
+LOGGER_URL="$URL&recv_buf_size=4194304"
 
 if [[ $# -lt 3 ]]; then
   echo "usage: $0 udp_multicast|jvm_decode|zero_alloc OUTDIR RTFUSED [NAME=VALUE]..." >&2
@@ -119,7 +125,7 @@ rtfused_args=()
 record() {
   local log=$1
   command -v lcm-logger >/dev/null || die "lcm-logger not found (package liblcm-bin)"
-  lcm-logger -q -f --lcm-url="$URL" "$log" >"$outdir/lcm-logger.out" 2>&1 &
+  lcm-logger -q -f --lcm-url="$LOGGER_URL" "$log" >"$outdir/lcm-logger.out" 2>&1 &
   local logger=$!
   pids+=("$logger")
   sleep 0.5
