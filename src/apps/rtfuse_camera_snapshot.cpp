@@ -13,8 +13,7 @@
 #include <memory>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
+#include "apps/command_line.hpp"
 #include "apps/stereo_png.hpp"
 #include "hal/mock/sim_clock.hpp"
 #include "hal/replay/replay_video_stream.hpp"
@@ -152,27 +151,22 @@ int from_recording(const std::string& log_path, const std::string& out_path, int
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-camera-snapshot: one rectified stereo pair of the configured camera as a PNG with epipolar guide lines"};
+  rtfuse::apps::CommandLine cli{"rtfuse-camera-snapshot: one rectified stereo pair of the configured camera as a PNG with epipolar guide lines"};
   std::string config_path, out_path = "stereo_pair.png", scenario_path;
   int guide_px = 24;
   int skip = 5;
   double at_s = 5.0;
   std::string recording_path;
-  auto* config_opt = app.add_option("-c,--config", config_path, "robot config (TOML) with a [camera]");
-  auto* recording_opt =
-      app.add_option("-r,--recording", recording_path, "an rtfused --record log with camera frames instead of a camera");
-  config_opt->excludes(recording_opt);
-  recording_opt->excludes(config_opt);
-  app.add_option("-o,--out", out_path, "PNG to write (default stereo_pair.png)");
-  app.add_option("-g,--guide", guide_px, "a guide line every N rows (0: none; default 24)");
-  app.add_option("-n,--skip", skip, "frames to let pass first, while exposure settles (default 5; of a recording: its first N)");
-  app.add_option("-s,--scenario", scenario_path, "simulated robot: drive scenario (default: the config's)");
-  app.add_option("-t,--time", at_s, "simulated robot: seconds into the drive (default 5)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+  auto config_opt = cli.option("-c,--config", &config_path, "robot config (TOML) with a [camera]");
+  auto recording_opt =
+      cli.option("-r,--recording", &recording_path, "an rtfused --record log with camera frames instead of a camera");
+  config_opt.excludes(recording_opt);
+  cli.option("-o,--out", &out_path, "PNG to write (default stereo_pair.png)");
+  cli.option("-g,--guide", &guide_px, "a guide line every N rows (0: none; default 24)");
+  cli.option("-n,--skip", &skip, "frames to let pass first, while exposure settles (default 5; of a recording: its first N)");
+  cli.option("-s,--scenario", &scenario_path, "simulated robot: drive scenario (default: the config's)");
+  cli.option("-t,--time", &at_s, "simulated robot: seconds into the drive (default 5)");
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
   if (!recording_path.empty()) return from_recording(recording_path, out_path, guide_px, skip);
   if (config_path.empty()) {
     std::fprintf(stderr, "rtfuse-camera-snapshot: give the camera's config (--config) or a recording (--recording)\n");

@@ -17,8 +17,7 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
+#include "apps/command_line.hpp"
 #include "hal/linux/monotonic_clock.hpp"
 #include "hal/linux/socketcan_bus.hpp"
 #include "sim/devices/canopen_encoder_node.hpp"
@@ -91,7 +90,7 @@ bool parse_fault(FaultKind kind, const std::string& spec, Fault* out, std::strin
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-canopen-node: simulated CiA 406 encoder nodes on a real CAN interface"};
+  rtfuse::apps::CommandLine cli{"rtfuse-canopen-node: simulated CiA 406 encoder nodes on a real CAN interface"};
   std::string ifname;
   std::vector<int> node_ids;
   double speed = 1000.0;
@@ -99,17 +98,17 @@ int main(int argc, char** argv) {
   double duration_s = 0.0;
   int width = 4;
   std::vector<std::string> silent, stuck, jump;
-  app.add_option("-i,--interface", ifname, "CAN interface (vcan0, can0)")->required();
-  app.add_option("-n,--node", node_ids, "node id 1..127 (repeat for several)")->required();
-  app.add_option("--speed", speed, "shaft speed of every node, counts/s")
-      ->capture_default_str();
-  app.add_option("--heartbeat-ms", heartbeat_ms, "heartbeat period, ms (0: none)")->capture_default_str();
-  app.add_option("--width", width, "position bytes in the TPDO, 1..4")->capture_default_str();
-  app.add_option("--duration", duration_s, "seconds to run (0: until SIGINT/SIGTERM)")->capture_default_str();
-  app.add_option("--silent", silent, "NODE:FROM_S:TO_S: the node is off the bus in that window");
-  app.add_option("--stuck", stuck, "NODE:FROM_S:TO_S: the node's counter stops in that window");
-  app.add_option("--jump", jump, "NODE:AT_S:COUNTS: the node's counter jumps by COUNTS");
-  CLI11_PARSE(app, argc, argv);
+  cli.option("-i,--interface", &ifname, "CAN interface (vcan0, can0)").required();
+  cli.option("-n,--node", &node_ids, "node id 1..127 (repeat for several)").required();
+  cli.option("--speed", &speed, "shaft speed of every node, counts/s")
+      .show_default();
+  cli.option("--heartbeat-ms", &heartbeat_ms, "heartbeat period, ms (0: none)").show_default();
+  cli.option("--width", &width, "position bytes in the TPDO, 1..4").show_default();
+  cli.option("--duration", &duration_s, "seconds to run (0: until SIGINT/SIGTERM)").show_default();
+  cli.option("--silent", &silent, "NODE:FROM_S:TO_S: the node is off the bus in that window");
+  cli.option("--stuck", &stuck, "NODE:FROM_S:TO_S: the node's counter stops in that window");
+  cli.option("--jump", &jump, "NODE:AT_S:COUNTS: the node's counter jumps by COUNTS");
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
 
   std::vector<rtfuse::sim::CanopenEncoderNode> nodes;
   nodes.reserve(node_ids.size());

@@ -21,8 +21,6 @@
 // memoryUsage()) and the pool's, the file, the grid and the map's digest.
 // Exit: 0 done, 1 a file could not be read or written, 2 usage, 3 the pool
 // filled (the map is incomplete; the message says what to raise).
-#include <CLI/CLI.hpp>
-
 #include <algorithm>
 #include <cerrno>
 #include <chrono>
@@ -35,6 +33,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/command_line.hpp"
 #include "apps/kitti_sequence.hpp"
 #include "apps/map_figure.hpp"
 #include "apps/point_cloud_file.hpp"
@@ -108,45 +107,41 @@ struct Scan {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-map: an occupancy map (OctoMap's semantics) built offline, written as .bt"};
+  rtfuse::apps::CommandLine cli{"rtfuse-map: an occupancy map (OctoMap's semantics) built offline, written as .bt"};
   std::string cloud_path, origin_text = "0,0,0", kitti_dir, poses_path, bt_path, out_path, grid_prefix, png_path;
   double resolution = 0.05, max_range = -1.0, z_min = -0.5, z_max = 2.0;
   int repeat = 1, first = 0, last = -1, every = 1, disparities = 96, downscale = 2;
-  std::size_t pool_mib = 512;
-  auto* cloud_opt =
-      app.add_option("--cloud", cloud_path, "point cloud, one \"x y z\" (metres) a line, as OctoMap's scan.dat");
-  app.add_option("--origin", origin_text, "--cloud: the sensor's position X,Y,Z in the cloud's frame (metres)");
-  app.add_option("--repeat", repeat, "--cloud: insert it this many times into an emptied map; ms_median over them")
-      ->check(CLI::Range(1, 1000));
-  auto* kitti_opt = app.add_option("--kitti", kitti_dir,
+  std::uint64_t pool_mib = 512;
+  auto cloud_opt =
+      cli.option("--cloud", &cloud_path, "point cloud, one \"x y z\" (metres) a line, as OctoMap's scan.dat");
+  cli.option("--origin", &origin_text, "--cloud: the sensor's position X,Y,Z in the cloud's frame (metres)");
+  cli.option("--repeat", &repeat, "--cloud: insert it this many times into an emptied map; ms_median over them")
+      .range(1, 1000);
+  auto kitti_opt = cli.option("--kitti", &kitti_dir,
                                    "KITTI-layout folder: image_l/ image_r/ (or image_0/ image_1/), calib.txt, "
                                    "poses.txt");
-  app.add_option("--poses", poses_path, "--kitti: the left camera's poses, KITTI format (default: its poses.txt)");
-  app.add_option("--first", first, "--kitti: the first frame")->check(CLI::NonNegativeNumber);
-  app.add_option("--last", last, "--kitti: the last frame (default: the last with a pose)");
-  app.add_option("--every", every, "--kitti: every n-th frame (keyframes)")->check(CLI::Range(1, 100000));
-  app.add_option("--disparities", disparities, "--kitti: disparities searched (a multiple of 16 x downscale)");
-  app.add_option("--downscale", downscale, "--kitti: 1 full resolution, 2 half (the live default)");
-  auto* bt_opt = app.add_option("--bt", bt_path, "an OctoMap binary tree (.bt): read, rewritten, projected");
-  cloud_opt->excludes(kitti_opt);
-  bt_opt->excludes(cloud_opt)->excludes(kitti_opt);
-  app.add_option("--resolution", resolution, "voxel edge (metres)");
-  app.add_option("--max-range", max_range,
+  cli.option("--poses", &poses_path, "--kitti: the left camera's poses, KITTI format (default: its poses.txt)");
+  cli.option("--first", &first, "--kitti: the first frame").non_negative();
+  cli.option("--last", &last, "--kitti: the last frame (default: the last with a pose)");
+  cli.option("--every", &every, "--kitti: every n-th frame (keyframes)").range(1, 100000);
+  cli.option("--disparities", &disparities, "--kitti: disparities searched (a multiple of 16 x downscale)");
+  cli.option("--downscale", &downscale, "--kitti: 1 full resolution, 2 half (the live default)");
+  auto bt_opt = cli.option("--bt", &bt_path, "an OctoMap binary tree (.bt): read, rewritten, projected");
+  cloud_opt.excludes(kitti_opt);
+  bt_opt.excludes(cloud_opt).excludes(kitti_opt);
+  cli.option("--resolution", &resolution, "voxel edge (metres)");
+  cli.option("--max-range", &max_range,
                  "rays longer than this free up to it and mark nothing (metres; negative: no limit)");
-  app.add_option("--pool-mib", pool_mib, "memory reserved for the map (MiB); a full pool drops updates, counted")
-      ->check(CLI::Range(1, 1 << 20));
-  app.add_option("-o,--out", out_path, "the map as OctoMap's binary tree (.bt)")->required();
-  app.add_option("--grid", grid_prefix, "also write the 2-D grid as map_server's PREFIX.pgm and PREFIX.yaml");
-  app.add_option("--png", png_path, "also draw the 2-D grid, the sensor's path, a legend and the figures");
-  app.add_option("--z-min", z_min, "the grid's lowest voxel centres (metres)");
-  app.add_option("--z-max", z_max, "the grid's highest voxel centres (metres)");
-  try {
-    app.parse(argc, argv);
-    if (cloud_path.empty() && kitti_dir.empty() && bt_path.empty()) {
-      throw CLI::RequiredError("--cloud, --kitti or --bt");
-    }
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
+  cli.option("--pool-mib", &pool_mib, "memory reserved for the map (MiB); a full pool drops updates, counted")
+      .range(1, 1 << 20);
+  cli.option("-o,--out", &out_path, "the map as OctoMap's binary tree (.bt)").required();
+  cli.option("--grid", &grid_prefix, "also write the 2-D grid as map_server's PREFIX.pgm and PREFIX.yaml");
+  cli.option("--png", &png_path, "also draw the 2-D grid, the sensor's path, a legend and the figures");
+  cli.option("--z-min", &z_min, "the grid's lowest voxel centres (metres)");
+  cli.option("--z-max", &z_max, "the grid's highest voxel centres (metres)");
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
+  if (cloud_path.empty() && kitti_dir.empty() && bt_path.empty()) {
+    return cli.usage_error("--cloud, --kitti or --bt is required");
   }
   std::vector<std::uint8_t> bt_bytes;
   if (!bt_path.empty()) {

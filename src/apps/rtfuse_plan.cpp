@@ -18,7 +18,6 @@
 // ms_median (over every plan; --repeat K plans each pair K times), the
 // expansions and the failures by reason. Exit: 0 done (whatever was
 // reached), 1 a file could not be read, 2 usage.
-#include <CLI/CLI.hpp>
 
 #include <algorithm>
 #include <chrono>
@@ -29,6 +28,7 @@
 #include <string>
 #include <vector>
 
+#include "apps/command_line.hpp"
 #include "apps/json_text.hpp"
 #include "apps/map_server_map.hpp"
 #include "apps/plan_pairs.hpp"
@@ -37,26 +37,26 @@
 
 int main(int argc, char** argv) {
   using namespace rtfuse;
-  CLI::App app{"rtfuse-plan: the grid planner on a saved map (map_server YAML + PGM)"};
+  rtfuse::apps::CommandLine cli{"rtfuse-plan: the grid planner on a saved map (map_server YAML + PGM)"};
   std::string map_path, pairs_path, unknown = "closed";
   double inflation = 0.0, decay = 0.0, scaling = 10.0, weight = 2.0;
   int repeat = 1;
   bool dijkstra = false;
-  app.add_option("--map", map_path, "the map's YAML (map_server's format, as rtfused --map-out writes it)")->required();
-  app.add_option("--pairs", pairs_path, "start and goal cells, \"sx sy gx gy\" a line")->required();
-  app.add_option("--inflation", inflation, "the robot's inscribed radius, m: cells this near an obstacle are closed")
-      ->check(CLI::Range(0.0, 10.0));
-  app.add_option("--decay", decay, "a band this wide beyond --inflation where costs fall off (costmap_2d's), m")
-      ->check(CLI::Range(0.0, 10.0));
-  app.add_option("--cost-scaling", scaling, "costmap_2d's cost_scaling_factor in the band, 1/m")
-      ->check(CLI::Range(0.0, 1000.0));
-  app.add_option("--cost-weight", weight, "a step costs its length x (1 + weight x cost / 252)")
-      ->check(CLI::Range(0.0, navigation::kMaxCostWeight));
-  app.add_option("--unknown", unknown, "unknown cells: closed or free")->check(CLI::IsMember({"closed", "free"}));
-  app.add_option("--repeat", repeat, "plan each pair this many times; the JSON has the median time")
-      ->check(CLI::Range(1, 1000));
-  app.add_flag("--dijkstra", dijkstra, "Dijkstra instead of A* (the same costs, more cells expanded)");
-  CLI11_PARSE(app, argc, argv);
+  cli.option("--map", &map_path, "the map's YAML (map_server's format, as rtfused --map-out writes it)").required();
+  cli.option("--pairs", &pairs_path, "start and goal cells, \"sx sy gx gy\" a line").required();
+  cli.option("--inflation", &inflation, "the robot's inscribed radius, m: cells this near an obstacle are closed")
+      .range(0.0, 10.0);
+  cli.option("--decay", &decay, "a band this wide beyond --inflation where costs fall off (costmap_2d's), m")
+      .range(0.0, 10.0);
+  cli.option("--cost-scaling", &scaling, "costmap_2d's cost_scaling_factor in the band, 1/m")
+      .range(0.0, 1000.0);
+  cli.option("--cost-weight", &weight, "a step costs its length x (1 + weight x cost / 252)")
+      .range(0.0, navigation::kMaxCostWeight);
+  cli.option("--unknown", &unknown, "unknown cells: closed or free").one_of({"closed", "free"});
+  cli.option("--repeat", &repeat, "plan each pair this many times; the JSON has the median time")
+      .range(1, 1000);
+  cli.flag("--dijkstra", &dijkstra, "Dijkstra instead of A* (the same costs, more cells expanded)");
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
 
   apps::OccupancyGridMap map;
   const std::string map_error = apps::load_map_server(map_path, &map);

@@ -13,8 +13,7 @@
 #include <cstring>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
+#include "apps/command_line.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
@@ -173,28 +172,23 @@ int replay_recording(const std::string& log_path, const std::string& config_path
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-replay: run rtfuse in lockstep with an LCM log (lcm-logger format)"};
+  rtfuse::apps::CommandLine cli{"rtfuse-replay: run rtfuse in lockstep with an LCM log (lcm-logger format)"};
   std::string config_path, log_path, out_path;
   bool quiet = false;
   bool allow_truncated = false;
   std::uint64_t frame_memory_mib = rtfuse::HalRecordingOptions{}.max_frame_bytes >> 20;
-  app.add_option("-c,--config", config_path,
+  cli.option("-c,--config", &config_path,
                  "TOML config (required for an ordinary log; a HAL recording carries its own)");
-  app.add_option("-l,--log", log_path, "input LCM log")->required();
-  app.add_option("-o,--out", out_path, "write the published channels to this LCM log");
-  app.add_flag("--allow-truncated", allow_truncated,
+  cli.option("-l,--log", &log_path, "input LCM log").required();
+  cli.option("-o,--out", &out_path, "write the published channels to this LCM log");
+  cli.flag("--allow-truncated", &allow_truncated,
                "replay the complete part of a HAL recording whose recorder was killed");
-  app.add_option("--frame-memory", frame_memory_mib,
+  cli.option("--frame-memory", &frame_memory_mib,
                  "MiB a HAL recording's camera frames may take in memory (each padded to its buffer)")
-      ->check(CLI::Range(std::uint64_t{1}, std::uint64_t{1} << 24))
-      ->capture_default_str();
-  app.add_flag("-q,--quiet", quiet, "no progress line");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help is a ParseError with exit code 0; every real error is a usage error (2).
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+      .range(1, 1 << 24)
+      .show_default();
+  cli.flag("-q,--quiet", &quiet, "no progress line");
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
 
   const bool tty = !quiet && isatty(STDERR_FILENO) != 0;
   std::string why;

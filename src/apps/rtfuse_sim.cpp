@@ -21,9 +21,7 @@
 #include <cstring>
 #include <string>
 
-#include <CLI/CLI.hpp>
-
-
+#include "apps/command_line.hpp"
 #include "apps/mapper_files.hpp"
 #include "apps/nav_figure.hpp"
 #include "runtime/config/config_loader.hpp"
@@ -96,29 +94,25 @@ struct SoakReport {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-sim: drive the simulated robot in lockstep and record the drive at HAL level"};
+  rtfuse::apps::CommandLine cli{"rtfuse-sim: drive the simulated robot in lockstep and record the drive at HAL level"};
   std::string config_path, scenario_path, out_path;
   bool quiet = false;
   double report_every = 0;
-  app.add_option("-c,--config", config_path, "robot config (TOML) with [hardware] backend = \"sim\"")->required();
-  app.add_option("-s,--scenario", scenario_path, "drive scenario (default: the config's [hardware] scenario)");
-  app.add_option("-o,--out", out_path, "write the drive to this LCM log (a HAL recording)");
+  cli.option("-c,--config", &config_path, "robot config (TOML) with [hardware] backend = \"sim\"").required();
+  cli.option("-s,--scenario", &scenario_path, "drive scenario (default: the config's [hardware] scenario)");
+  cli.option("-o,--out", &out_path, "write the drive to this LCM log (a HAL recording)");
   std::string trace_path;
-  app.add_option("--trace", trace_path,
+  cli.option("--trace", &trace_path,
                  "write t, the truth and every instance's x y yaw (and map -> odom) at 50 Hz to this CSV file");
   std::string map_out, nav_out;
-  app.add_option("--nav-out", nav_out,
+  cli.option("--nav-out", &nav_out,
                  "write the navigator's costmap, its last path, the truly driven trajectory and the goals as a PNG");
-  app.add_option("--map-out", map_out,
+  cli.option("--map-out", &map_out,
                  "write the mapper's map at the end: PREFIX.bt, PREFIX.pgm + PREFIX.yaml and PREFIX.png");
-  app.add_flag("-q,--quiet", quiet, "no progress line");
-  app.add_option("--report-every", report_every, "a JSON line every S simulated seconds (the soak; 0: none)")
-      ->check(CLI::NonNegativeNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+  cli.flag("-q,--quiet", &quiet, "no progress line");
+  cli.option("--report-every", &report_every, "a JSON line every S simulated seconds (the soak; 0: none)")
+      .non_negative();
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
   std::string text;
   int err = 0;
   if (!rtfuse::read_text_file(config_path, &text, &err)) {

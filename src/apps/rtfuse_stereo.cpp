@@ -14,8 +14,7 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
+#include "apps/command_line.hpp"
 #include "apps/disparity_png.hpp"
 #include "apps/grey_png.hpp"
 #include "apps/json_text.hpp"
@@ -28,24 +27,20 @@ using rtfuse::apps::json_string;
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-stereo: dense disparity of the left view of a rectified stereo pair (KITTI 16-bit PNG)"};
+  rtfuse::apps::CommandLine cli{"rtfuse-stereo: dense disparity of the left view of a rectified stereo pair (KITTI 16-bit PNG)"};
   std::string left_path, right_path, out_path;
   int disparities = 0, downscale = 1, repeat = 1;
-  app.add_option("left", left_path, "left view, PNG (grey or colour), rectified")->required();
-  app.add_option("right", right_path, "right view, PNG, same size, rectified")->required();
-  app.add_option("-d,--disparities", disparities,
+  cli.option("left", &left_path, "left view, PNG (grey or colour), rectified").required();
+  cli.option("right", &right_path, "right view, PNG, same size, rectified").required();
+  cli.option("-d,--disparities", &disparities,
                  "disparities searched, 0..N-1, in input pixels: a multiple of 16 (of 32 with --downscale 2)")
-      ->required();
-  app.add_option("--downscale", downscale, "1: match at full resolution, 2: at half (the live default)")
-      ->check(CLI::IsMember({1, 2}));
-  app.add_option("--repeat", repeat, "run the matcher this many times; the JSON has the median time")
-      ->check(CLI::Range(1, 100000));
-  app.add_option("-o,--out", out_path, "disparity PNG to write: 16-bit, disparity x 256, 0 = no estimate");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+      .required();
+  cli.option("--downscale", &downscale, "1: match at full resolution, 2: at half (the live default)")
+      .one_of({"1", "2"});
+  cli.option("--repeat", &repeat, "run the matcher this many times; the JSON has the median time")
+      .range(1, 100000);
+  cli.option("-o,--out", &out_path, "disparity PNG to write: 16-bit, disparity x 256, 0 = no estimate");
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
 
   rtfuse::apps::GreyPng left, right;
   std::string error;

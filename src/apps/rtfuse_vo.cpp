@@ -18,9 +18,9 @@
 #include <string>
 #include <vector>
 
-#include <CLI/CLI.hpp>
 #include <Eigen/LU>
 
+#include "apps/command_line.hpp"
 #include "apps/grey_png.hpp"
 #include "apps/kitti_sequence.hpp"
 #include "apps/trajectory_metrics.hpp"
@@ -54,25 +54,21 @@ void print_errors(const rtfuse::apps::TrajectoryErrors& e) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfuse-vo: stereo visual odometry on a KITTI-layout folder of rectified pairs"};
+  rtfuse::apps::CommandLine cli{"rtfuse-vo: stereo visual odometry on a KITTI-layout folder of rectified pairs"};
   std::string dir, out_path, plot_path;
   int max_frames = 0;
   int eval_from = 0;
-  app.add_option("--kitti", dir, "sequence folder: image_l/ image_r/ (or image_0/ image_1/), calib.txt, [poses.txt]")
-      ->required();
-  app.add_option("-o,--out", out_path, "poses to write, KITTI format");
-  app.add_option("--plot", plot_path,
+  cli.option("--kitti", &dir, "sequence folder: image_l/ image_r/ (or image_0/ image_1/), calib.txt, [poses.txt]")
+      .required();
+  cli.option("-o,--out", &out_path, "poses to write, KITTI format");
+  cli.option("--plot", &plot_path,
                  "PNG: top view against the ground truth in metres, legend, key figures, the error over frames");
-  app.add_option("-n,--frames", max_frames, "at most this many frames (0: all)");
-  app.add_option("--eval-from", eval_from,
+  cli.option("-n,--frames", &max_frames, "at most this many frames (0: all)");
+  cli.option("--eval-from", &eval_from,
                  "also judge the frames from this one on against the ground truth, both re-anchored there "
                  "(\"from_frame\" in the JSON): a stretch whose ground truth is measured")
-      ->check(CLI::NonNegativeNumber);
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+      .non_negative();
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
   rtfuse::apps::KittiSequence seq;
   std::string error;
   if (!rtfuse::apps::open_kitti_sequence(dir, &seq, &error)) {

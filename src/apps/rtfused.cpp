@@ -18,8 +18,7 @@
 #include <thread>
 #include <vector>
 
-#include <CLI/CLI.hpp>
-
+#include "apps/command_line.hpp"
 #include "apps/mapper_files.hpp"
 #include "hal/linux/monotonic_clock.hpp"
 #include "mapping/map_digest.hpp"
@@ -102,35 +101,25 @@ void truth_thread(rtfuse::sim::SimRobot* robot, rtfuse::transport::LcmNode* lcm,
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"rtfused: real-time EKF sensor fusion daemon (LCM in, LCM out)"};
+  rtfuse::apps::CommandLine cli{"rtfused: real-time EKF sensor fusion daemon (LCM in, LCM out)"};
   std::string config_path;
   double duration = 0.0;
   std::string lcm_url;
   bool quiet = false;
-  app.set_version_flag("--version", "rtfused " RTFUSE_VERSION);
-  app.add_option("-c,--config", config_path, "TOML config (default: the embedded config/sim.toml)");
-  app.add_option("-d,--duration", duration, "stop after this many seconds (0: run until SIGINT/SIGTERM)")
-      ->check([](const std::string& v) {
-        double d = -1.0;
-        return CLI::detail::lexical_cast(v, d) && d >= 0.0 && std::isfinite(d)
-                   ? std::string()
-                   : "must be a number of seconds >= 0, got '" + v + "'";
-      });
-  app.add_option("--lcm-url", lcm_url, "override [lcm] url");
-  app.add_flag("-q,--quiet", quiet, "no live status line");
+  cli.version_flag("--version", "rtfused " RTFUSE_VERSION);
+  cli.option("-c,--config", &config_path, "TOML config (default: the embedded config/sim.toml)");
+  cli.option("-d,--duration", &duration, "stop after this many seconds (0: run until SIGINT/SIGTERM)")
+      .non_negative();
+  cli.option("--lcm-url", &lcm_url, "override [lcm] url");
+  cli.flag("-q,--quiet", &quiet, "no live status line");
   std::string record_path;
-  app.add_option("--record", record_path,
+  cli.option("--record", &record_path,
                  "write every bus event, loop tick and output to this LCM log (replay it with rtfuse-replay)");
   std::string map_out;
-  app.add_option("--map-out", map_out,
+  cli.option("--map-out", &map_out,
                  "with [mapping]: write the map at exit to PREFIX.bt, PREFIX.pgm + .yaml and PREFIX.png "
                  "(overrides [mapping] output)");
-  try {
-    app.parse(argc, argv);
-  } catch (const CLI::ParseError& e) {
-    // --help is a ParseError with exit code 0; every real error is a usage error (2).
-    return app.exit(e) == 0 ? 0 : 2;
-  }
+  if (const auto exit = cli.parse(argc, argv)) return *exit;
 
   std::string config_text(rtfuse::apps::kEmbeddedSimConfig);
   if (!config_path.empty()) {
