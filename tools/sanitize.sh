@@ -54,16 +54,23 @@ case "$kind" in
     # live GNSS run and the unit tests. So is the camera slip drive (160 s
     # here, a quarter of the stage's CPU): its checks are the filter's
     # response to a slip, and every line it runs, camera, odometry and
-    # fusion, runs here in the plain-wall drive, the camera's lockstep
-    # drives, the mapper's and the live recording. And the map's accuracy on
+    # fusion, runs here in the camera's lockstep drives, the mapper's and
+    # the live recording. So is the plain-wall drive (145 s here, the
+    # stage's longest): its checks are the odometry's refusals of grey pairs
+    # and the estimate's steadiness; the refusal runs here in the odometry's
+    # unit tests (dark and flashed pairs), the drive's path (render, match,
+    # fuse, record, replay) in the camera's lockstep drives. And the map's accuracy on
     # the obstacle course (50 s here): it scores depth and map against the
     # world's truth; its renderer, matcher and map run here in the rendered
     # pairs' tests and the mapper's lockstep drive. And the navigator's
     # closed loop (30 s natively, minutes here): its navigator runs here in
     # its own unit tests and in the daemon fuzzer, its drive in the
-    # mapper's and the commanded base's lockstep drives.
+    # mapper's and the commanded base's lockstep drives. And the planner
+    # against Boost on the mapped obstacle course: it maps the lap as the
+    # accuracy test does (left to the native stage above), then compares
+    # plans, which the random grids' comparison does here.
     (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference \
-      -E '^(integration_gnss_drive|integration_camera_slip|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays)$' "$@")
+      -E '^(integration_gnss_drive|integration_camera_slip|integration_plain_wall|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays|BoostGraphReference\.TheMappedObstacleCourseGivesBoostsCostsToo)$' "$@")
     ;;
   tsan)
     build_tsan
