@@ -361,9 +361,12 @@ int main(int argc, char** argv) {
     for (const rtfuse::sim::GoalOutcome& g : goals->outcomes()) {
       ++i;
       if (!g.sent) continue;
-      std::printf("rtfused: goal %d: %s, %.3f m from it (truth)%s%s\n", i,
-                  g.reached ? "reached" : g.rejected ? "refused" : "not reached", g.truth_error_m,
-                  g.why.empty() ? "" : ": ", g.why.c_str());
+      if (!g.reached && !g.rejected) {  // no outcome yet: no distance was taken
+        std::printf("rtfused: goal %d: still driving to it at exit (sent at %.1f s)\n", i, g.sent_s);
+        continue;
+      }
+      std::printf("rtfused: goal %d: %s, %.3f m from it (truth)%s%s\n", i, g.reached ? "reached" : "refused",
+                  g.truth_error_m, g.why.empty() ? "" : ": ", g.why.c_str());
     }
   }
   if ((sim || robot) && err_samples > 0) {
