@@ -17,7 +17,6 @@
 #include "mapping/disparity_points.hpp"
 #include "mapping/grid_projection.hpp"
 #include "mapping/occupancy_map.hpp"
-#include "navigation/costmap.hpp"
 #include "navigation/grid_planner.hpp"
 #include "sim/camera_world.hpp"
 #include "sim/drive_scenario.hpp"
@@ -162,12 +161,7 @@ inline SyntheticCostmap obstacle_course_costmap(const mapping::OccupancyMap& map
   const mapping::GridSpec spec = mapping::grid_around(map.grid(), 3.0, 5.0, size, size, 0.1, 2.0);
   std::vector<std::int8_t> cells(spec.cells());
   mapping::project_to_grid(map, spec, cells.data());
-  navigation::Costmap costmap(size, size, navigation::CostmapParams{});
-  costmap.set_grid(cells.data());
-  SyntheticCostmap out;
-  out.width = size;
-  out.height = size;
-  out.cost.assign(costmap.view().cost, costmap.view().cost + cells.size());
+  SyntheticCostmap out = costmap_of_grid(cells, size);
   std::mt19937 rng(seed);
   const auto random_cell = [&] {
     const int x = static_cast<int>(rng() % static_cast<std::uint32_t>(size));

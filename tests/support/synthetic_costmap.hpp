@@ -30,6 +30,18 @@ struct SyntheticCostmap {
   navigation::CostView view() const { return navigation::CostView{cost.data(), width, height}; }
 };
 
+// The costs of a size x size occupancy grid (nav_msgs/OccupancyGrid
+// values) by navigation::Costmap with its defaults; no pairs yet.
+inline SyntheticCostmap costmap_of_grid(const std::vector<std::int8_t>& grid, int size) {
+  navigation::Costmap costmap(size, size, navigation::CostmapParams{});
+  costmap.set_grid(grid.data());
+  SyntheticCostmap out;
+  out.width = size;
+  out.height = size;
+  out.cost.assign(costmap.view().cost, costmap.view().cost + grid.size());
+  return out;
+}
+
 inline SyntheticCostmap synthetic_costmap(bool inner_walls = true, int size = 400, std::size_t pairs = 100,
                                           std::uint32_t seed = 28) {
   std::mt19937 rng(seed);
@@ -84,12 +96,7 @@ inline SyntheticCostmap synthetic_costmap(bool inner_walls = true, int size = 40
     fill(x, y, x + w, y + h, -1);
   }
 
-  navigation::Costmap costmap(size, size, navigation::CostmapParams{});
-  costmap.set_grid(grid.data());
-  SyntheticCostmap out;
-  out.width = size;
-  out.height = size;
-  out.cost.assign(costmap.view().cost, costmap.view().cost + grid.size());
+  SyntheticCostmap out = costmap_of_grid(grid, size);
   const auto passable_cell = [&] {
     for (;;) {
       const int x = below(size);
