@@ -91,6 +91,10 @@ class HalReplay {
   bool catch_up(const transport::LoopTick& t);
   // Hands each device the recorded inputs the live loop had taken by tick t.
   void deliver_inputs(const transport::LoopTick& t);
+  // Lets the workers (the mapper, the navigator) do what is due: after
+  // every tick and every camera step. What they do does not depend on how
+  // often they are stepped, only on what was due.
+  void step_workers();
   // A divergence or the end of a stream stops the replay: true then.
   bool stopped_by_a_stream();
   bool stopped_by_video(const hal::replay::ReplayVideoLog* v, const char* device);
@@ -172,7 +176,16 @@ bool HalReplay::catch_up(const transport::LoopTick& t) {
     // loop has what it took live. A stream that ends or diverges first
     // cannot give more.
     if (r.free_clock != nullptr && device.samples() < target) r.free_clock->sleep_until(t.time_ns);
-    while (device.samples() < target && more()) device.step(kDeviceStepTimeoutNs);
+    while (device.samples() < target && more()) {
+      device.step(kDeviceStepTimeoutNs);
+      // A camera's pairs that gave the loop no sample (skipped, or while
+      // its odometry restarted) come here in one burst at the next tick
+      // that took one. Live, the mapper's thread mapped each keyframe
+      // among them once the loop was past it, before the next arrived;
+      // without a step between them its queue of two would overflow here
+      // and drop a keyframe the live mapper kept.
+      if (r.video != nullptr) step_workers();
+    }
     if (stopped_by_video(r.video, name)) return false;
     // Ticking on without the samples the live loop had would publish
     // something it never published: the recording ends here.
@@ -222,7 +235,7 @@ void HalReplay::run_ticks(const std::function<void(const HalReplayProgress&)>& p
     if (stopped_by_a_stream()) break;
     // Workers (the mapper) do what this tick made due, as their live thread
     // did at some later moment: what they do does not depend on when.
-    if (Hardware* hw = pipeline_->hardware()) hw->step_workers();
+    step_workers();
     ++result_.ticks;
     ++prog.ticks;
     if (progress && prog.ticks % 10000 == 0) progress(prog);
@@ -247,6 +260,7 @@ void HalReplay::finish_video() {
     // which the free-running clock ends at the next step: bounded.
     for (std::size_t k = 0; k < 2 * log.size() + 16 && !log.diverged() && !log.at_end(); ++k) {
       device.step(kDeviceStepTimeoutNs);
+      step_workers();  // as in catch_up: the mapper takes each pair as its thread did
     }
     const std::string stream = "stream '" + std::string(name) + "'";
     if (log.divergence_kind() == hal::replay::DivergenceKind::kMismatch) {
@@ -257,6 +271,10 @@ void HalReplay::finish_video() {
       result_.note = "the recording of " + stream + " ends early: " + log.divergence();
     }
   }
+}
+
+void HalReplay::step_workers() {
+  if (Hardware* hw = pipeline_->hardware()) hw->step_workers();
 }
 
 void HalReplay::finish_workers() {
