@@ -22,7 +22,8 @@
 // What it maps depends on the pairs lent and the loop's estimates only,
 // never on when its thread ran: a keyframe's pose is looked up "as of" the
 // tick pose_delay after its stamp, whenever the lookup happens. So a
-// replay or a lockstep drive, which step it after every tick, builds the
+// replay or a lockstep drive, which step it after every tick (a replay
+// also after every camera step: its pairs can come in bursts), builds the
 // same map, bit for bit, as the live thread did, unless the live queue
 // overflowed (counted in `dropped`).
 //
