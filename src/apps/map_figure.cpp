@@ -4,26 +4,19 @@
 #include <cmath>
 
 #include "apps/grid_figure.hpp"
-#include "apps/legend.hpp"
 
 namespace rtfuse::apps {
 namespace {
 
-constexpr int kScale = kGridFigureScale;
-constexpr Rgb kWhite{255, 255, 255};
-constexpr Rgb kInk{0, 0, 0};
 constexpr Rgb kOccupied{0, 0, 0};
 constexpr Rgb kFree{254, 254, 254};
-constexpr Rgb kUnknown{205, 205, 205};
+constexpr Rgb kUnknown = kGridFigureUnknown;
 constexpr Rgb kPath{220, 40, 40};
-constexpr Rect kView = kGridFigureView;
-constexpr int kColumnX = kGridFigureColumnX;
 
 }  // namespace
 
 bool write_map_png(const MapFigure& f, const std::string& path, std::string* error) {
-  Canvas canvas(1400, 920, kWhite);
-  canvas.text(kView.x, 20, f.title, kInk, kScale, true);
+  Canvas canvas = grid_figure_page(f.title);
   Range xr, yr;
   xr.include(f.origin_x);
   xr.include(f.origin_x + f.width * f.resolution);
@@ -33,12 +26,7 @@ bool write_map_png(const MapFigure& f, const std::string& path, std::string* err
     xr.include(p.x);
     yr.include(p.y);
   }
-  AxesOptions options;
-  options.equal_aspect = true;
-  options.x_title = "x [m]";
-  options.y_title = "y [m]";
-  const Axes axes(kView, xr, yr, options);
-  axes.draw_grid(canvas);
+  const Axes axes = grid_figure_axes(canvas, xr, yr);
   // Occupied drawn last, so it shows where cells share a pixel.
   canvas.set_clip(axes.area());
   const GridPlacement placement{f.origin_x, f.origin_y, f.resolution};
@@ -63,9 +51,7 @@ bool write_map_png(const MapFigure& f, const std::string& path, std::string* err
       {"sensor path", kPath, false, Marker::kDisc, 2, false},
       {"start", kPath, true, Marker::kCircle, 2, false},
   };
-  const Rect box = draw_legend(canvas, kColumnX, kView.y, legend, kScale);
-  draw_text_lines(canvas, kColumnX, box.bottom() + 30, f.figures, kInk, kScale);
-  return write_png(canvas, path, error);
+  return finish_grid_figure(canvas, legend, f.figures, path, error);
 }
 
 }  // namespace rtfuse::apps

@@ -4,23 +4,17 @@
 #include <cmath>
 
 #include "apps/grid_figure.hpp"
-#include "apps/legend.hpp"
 
 namespace rtfuse::apps {
 namespace {
 
-constexpr int kNavScale = kGridFigureScale;
-constexpr Rgb kNavWhite{255, 255, 255};
-constexpr Rgb kNavInk{0, 0, 0};
 constexpr Rgb kLethal{0, 0, 0};
 constexpr Rgb kInscribed{150, 20, 40};
-constexpr Rgb kNavUnknown{205, 205, 205};
+constexpr Rgb kNavUnknown = kGridFigureUnknown;
 constexpr Rgb kTruthBox{0, 150, 60};
 constexpr Rgb kPlanned{30, 90, 220};
 constexpr Rgb kDriven{220, 40, 40};
 constexpr Rgb kGoal{230, 140, 0};
-constexpr Rect kNavView = kGridFigureView;
-constexpr int kNavColumnX = kGridFigureColumnX;
 
 // Inflation from white (0) to a full rose (252), as costmap_2d's viewers shade it.
 Rgb cost_colour(std::uint8_t c) noexcept {
@@ -35,8 +29,7 @@ Rgb cost_colour(std::uint8_t c) noexcept {
 }  // namespace
 
 bool write_nav_png(const NavFigure& f, const std::string& path, std::string* error) {
-  Canvas canvas(1400, 920, kNavWhite);
-  canvas.text(kNavView.x, 20, f.title, kNavInk, kNavScale, true);
+  Canvas canvas = grid_figure_page(f.title);
   // The view: what was known and everything drawn over it.
   Range xr, yr;
   for (int j = 0; j < f.height; ++j) {
@@ -60,12 +53,7 @@ bool write_nav_png(const NavFigure& f, const std::string& path, std::string* err
     yr.include(f.origin_y);
     yr.include(f.origin_y + f.height * f.resolution);
   }
-  AxesOptions options;
-  options.equal_aspect = true;
-  options.x_title = "x [m]";
-  options.y_title = "y [m]";
-  const Axes axes(kNavView, xr, yr, options);
-  axes.draw_grid(canvas);
+  const Axes axes = grid_figure_axes(canvas, xr, yr);
   canvas.set_clip(axes.area());
   // Low costs first, so the higher ones of cells sharing a pixel show.
   const GridPlacement placement{f.origin_x, f.origin_y, f.resolution};
@@ -99,9 +87,7 @@ bool write_nav_png(const NavFigure& f, const std::string& path, std::string* err
       {"start", kDriven, true, Marker::kCircle, 2, false},
       {"goals", kGoal, true, Marker::kDisc, 2, false},
   };
-  const Rect box = draw_legend(canvas, kNavColumnX, kNavView.y, legend, kNavScale);
-  draw_text_lines(canvas, kNavColumnX, box.bottom() + 30, f.figures, kNavInk, kNavScale);
-  return write_png(canvas, path, error);
+  return finish_grid_figure(canvas, legend, f.figures, path, error);
 }
 
 }  // namespace rtfuse::apps
