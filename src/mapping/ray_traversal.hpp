@@ -163,17 +163,44 @@ inline bool near_edge(const VoxelKey& k) noexcept {
 
 }  // namespace detail
 
-// Calls visit(std::uint64_t packed_key) (pack()) for each voxel from origin
-// towards end, end's voxel excluded. False (nothing visited) when either
-// point is outside the map. The number of voxels is bounded by the
-// segment's length over the resolution (at most three steps per voxel
-// length).
-template <class Visit>
-bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
-  VoxelKey key_origin, key_end;
-  if (!grid.key_of(origin, key_origin) || !grid.key_of(end, key_end)) return false;
-  if (key_origin == key_end) return true;
-  visit(pack(key_origin));
+// A ray set up for the branch-free loop below (detail::choose's terms):
+// per axis the distance to the next border crossed (t), the one after (n)
+// as double bits, the sum two ahead (c), the step's distance (dd, bits) and
+// its step of the packed key (k); the packed key now and at the end, and
+// the segment's length (bits). ray_batch.hpp runs four of these at once.
+struct RayState {
+  std::uint64_t t[3];
+  std::uint64_t n[3];
+  double c[3];
+  std::uint64_t dd[3];
+  std::uint64_t k[3];
+  std::uint64_t current;
+  std::uint64_t end;
+  std::uint64_t limit;
+};
+
+enum class RayStart : std::uint8_t {
+  kOutside,  // an end outside the map: nothing to visit
+  kEmpty,    // both ends in one voxel: nothing to visit
+  kExact,    // the origin's voxel, then OctoMap's loop as written (traverse_exact)
+  kFast,     // the origin's voxel, then the loop over a RayState
+};
+
+namespace detail {
+
+struct RaySetup {
+  VoxelKey key_origin;
+  VoxelKey key_end;
+  int step[3];
+  double t_max[3];
+  double t_delta[3];
+  double limit;
+};
+
+// OctoMap's set-up of computeRayKeys, in its precisions.
+inline RayStart set_up_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, RaySetup& r) noexcept {
+  if (!grid.key_of(origin, r.key_origin) || !grid.key_of(end, r.key_end)) return RayStart::kOutside;
+  if (r.key_origin == r.key_end) return RayStart::kEmpty;
 
   const float dir[3] = {end.x - origin.x, end.y - origin.y, end.z - origin.z};
   const float o[3] = {origin.x, origin.y, origin.z};
@@ -182,53 +209,79 @@ bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const Ma
   float d[3] = {dir[0] / length, dir[1] / length, dir[2] / length};
 
   const double resolution = grid.resolution();
-  int step[3];
-  double t_max[3];
-  double t_delta[3];
   for (int i = 0; i < 3; ++i) {
-    step[i] = d[i] > 0.0f ? 1 : (d[i] < 0.0f ? -1 : 0);
-    if (step[i] != 0) {
-      double border = grid.centre(key_origin.k[i]);
-      border += static_cast<float>(step[i] * resolution * 0.5);
-      t_max[i] = (border - static_cast<double>(o[i])) / static_cast<double>(d[i]);
-      t_delta[i] = resolution / static_cast<double>(std::fabs(d[i]));
+    r.step[i] = d[i] > 0.0f ? 1 : (d[i] < 0.0f ? -1 : 0);
+    if (r.step[i] != 0) {
+      double border = grid.centre(r.key_origin.k[i]);
+      border += static_cast<float>(r.step[i] * resolution * 0.5);
+      r.t_max[i] = (border - static_cast<double>(o[i])) / static_cast<double>(d[i]);
+      r.t_delta[i] = resolution / static_cast<double>(std::fabs(d[i]));
     } else {
-      t_max[i] = std::numeric_limits<double>::max();
-      t_delta[i] = std::numeric_limits<double>::max();
+      r.t_max[i] = std::numeric_limits<double>::max();
+      r.t_delta[i] = std::numeric_limits<double>::max();
     }
   }
-
-  const double limit = static_cast<double>(length);
-  if (t_max[0] < 0.0 || t_max[1] < 0.0 || t_max[2] < 0.0 || detail::near_edge(key_origin) ||
-      detail::near_edge(key_end)) {
-    // An origin a rounding away from its voxel's far border (negative
-    // distances order differently as integers), or a ray at the map's
-    // edge: OctoMap's loop as written.
-    auto visit_key = [&](const VoxelKey& k) { visit(pack(k)); };
-    detail::traverse_exact(t_max, t_delta, step, key_origin, key_end, limit, visit_key);
-    return true;
+  r.limit = static_cast<double>(length);
+  // An origin a rounding away from its voxel's far border (negative
+  // distances order differently as integers), or a ray at the map's edge:
+  // OctoMap's loop as written.
+  if (r.t_max[0] < 0.0 || r.t_max[1] < 0.0 || r.t_max[2] < 0.0 || near_edge(r.key_origin) ||
+      near_edge(r.key_end)) {
+    return RayStart::kExact;
   }
-  // OctoMap's loop without its branches: which axis steps next is a coin
-  // toss for the branch predictor, and a mispredicted branch per voxel was
-  // most of the traversal's time. Non-negative doubles order as their bit
-  // patterns do, so the comparisons are integer ones feeding conditional
-  // moves, and each axis's next distance is summed ahead (OctoMap's same
-  // sum, tMax + tDelta), off the path from one step to the next. An axis
-  // that does not step adds +0.0, which leaves a non-negative sum as it is.
-  const std::uint64_t dd0 = detail::bits_of(t_delta[0]), dd1 = detail::bits_of(t_delta[1]),
-                      dd2 = detail::bits_of(t_delta[2]);
-  double a0 = t_max[0] + 0.0, a1 = t_max[1] + 0.0, a2 = t_max[2] + 0.0;  // + 0.0: -0.0 becomes +0.0
-  double b0 = a0 + t_delta[0], b1 = a1 + t_delta[1], b2 = a2 + t_delta[2];
-  std::uint64_t t0 = detail::bits_of(a0), t1 = detail::bits_of(a1), t2 = detail::bits_of(a2);
-  std::uint64_t n0 = detail::bits_of(b0), n1 = detail::bits_of(b1), n2 = detail::bits_of(b2);
-  double c0 = b0 + t_delta[0], c1 = b1 + t_delta[1], c2 = b2 + t_delta[2];  // the sums two steps ahead
+  return RayStart::kFast;
+}
+
+// OctoMap's loop without its branches: which axis steps next is a coin
+// toss for the branch predictor, and a mispredicted branch per voxel was
+// most of the traversal's time. Non-negative doubles order as their bit
+// patterns do, so the comparisons are integer ones feeding conditional
+// moves, and each axis's next distance is summed ahead (OctoMap's same
+// sum, tMax + tDelta), off the path from one step to the next. An axis
+// that does not step adds +0.0, which leaves a non-negative sum as it is.
+inline RayState fast_state(const RaySetup& r) noexcept {
+  RayState s;
+  for (int i = 0; i < 3; ++i) {
+    const double a = r.t_max[i] + 0.0;  // + 0.0: -0.0 becomes +0.0
+    const double b = a + r.t_delta[i];
+    s.t[i] = bits_of(a);
+    s.n[i] = bits_of(b);
+    s.c[i] = b + r.t_delta[i];  // the sum two steps ahead
+    s.dd[i] = bits_of(r.t_delta[i]);
+  }
   // A step is one add to the packed key (no field leaves its 16 bits: near_edge).
-  const std::uint64_t k0 = static_cast<std::uint64_t>(static_cast<std::int64_t>(step[0]));
-  const std::uint64_t k1 = static_cast<std::uint64_t>(static_cast<std::int64_t>(step[1]) * 65536);
-  const std::uint64_t k2 = static_cast<std::uint64_t>(static_cast<std::int64_t>(step[2]) * 65536 * 65536);
-  std::uint64_t current = pack(key_origin);
-  const std::uint64_t end_packed = pack(key_end);
-  const std::uint64_t limit_bits = detail::bits_of(limit);
+  s.k[0] = static_cast<std::uint64_t>(static_cast<std::int64_t>(r.step[0]));
+  s.k[1] = static_cast<std::uint64_t>(static_cast<std::int64_t>(r.step[1]) * 65536);
+  s.k[2] = static_cast<std::uint64_t>(static_cast<std::int64_t>(r.step[2]) * 65536 * 65536);
+  s.current = pack(r.key_origin);
+  s.end = pack(r.key_end);
+  s.limit = bits_of(r.limit);
+  return s;
+}
+
+}  // namespace detail
+
+// Sets up a ray from origin towards end: what it is, and for kFast its
+// state. For kExact and kFast the origin's voxel (pack(key_origin)) is the
+// first voxel visited.
+inline RayStart start_ray(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, RayState& state,
+                          detail::RaySetup& setup) noexcept {
+  const RayStart kind = detail::set_up_ray(grid, origin, end, setup);
+  if (kind == RayStart::kFast) state = detail::fast_state(setup);
+  return kind;
+}
+
+// The voxels after the origin's of a kFast ray, end's voxel excluded.
+template <class Visit>
+void run_ray(RayState s, Visit& visit) {
+  std::uint64_t t0 = s.t[0], t1 = s.t[1], t2 = s.t[2];
+  std::uint64_t n0 = s.n[0], n1 = s.n[1], n2 = s.n[2];
+  double c0 = s.c[0], c1 = s.c[1], c2 = s.c[2];
+  const std::uint64_t dd0 = s.dd[0], dd1 = s.dd[1], dd2 = s.dd[2];
+  const std::uint64_t k0 = s.k[0], k1 = s.k[1], k2 = s.k[2];
+  std::uint64_t current = s.current;
+  const std::uint64_t end_packed = s.end;
+  const std::uint64_t limit_bits = s.limit;
   bool lt01, lt;
   detail::choose(t0, t1, t2, lt01, lt);
   for (;;) {
@@ -242,6 +295,28 @@ bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const Ma
     if (detail::choose(t0, t1, t2, lt01, lt) > limit_bits) break;
     visit(current);
   }
+}
+
+// Calls visit(std::uint64_t packed_key) (pack()) for each voxel from origin
+// towards end, end's voxel excluded. False (nothing visited) when either
+// point is outside the map. The number of voxels is bounded by the
+// segment's length over the resolution (at most three steps per voxel
+// length).
+template <class Visit>
+bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
+  detail::RaySetup setup;
+  RayState state{};
+  const RayStart kind = start_ray(grid, origin, end, state, setup);
+  if (kind == RayStart::kOutside) return false;
+  if (kind == RayStart::kEmpty) return true;
+  visit(pack(setup.key_origin));
+  if (kind == RayStart::kExact) {
+    auto visit_key = [&](const VoxelKey& k) { visit(pack(k)); };
+    detail::traverse_exact(setup.t_max, setup.t_delta, setup.step, setup.key_origin, setup.key_end, setup.limit,
+                           visit_key);
+    return true;
+  }
+  run_ray(state, visit);
   return true;
 }
 
