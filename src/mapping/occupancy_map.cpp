@@ -4,6 +4,7 @@
 #include <cstring>
 #include <stdexcept>
 
+#include "mapping/ray_batch.hpp"
 #include "mapping/ray_traversal.hpp"
 
 namespace rtfuse::mapping {
@@ -65,34 +66,73 @@ class OccupancyMap::ScanWriter {
     if (!is_dense(slot)) {
       const std::uint32_t block = map_.store_.new_block(slot);
       if (block == kNone) {
+        // Counted once: the voxel is done for this scan, so a hit lost here
+        // is not freed by a ray later in it either.
+        touched |= touched_bit;
         ++dropped_;
         return;
       }
       slot = b.sub[s] = dense_slot(block);
     }
     touched |= touched_bit;
-    std::uint32_t& cell = map_.store_.block_values(block_of(slot))[v];
-    const bool was_known = cell != kUnknownBits;
-    float value = was_known ? float_of(cell) : 0.0f;
-    const bool was_occupied = was_known && value >= map_.log_odds_.occupied;
-    // OctoMap's updateNodeLogOdds: add, then clamp.
-    value += delta;
-    if (value < map_.log_odds_.clamp_min) {
-      value = map_.log_odds_.clamp_min;
-    } else if (value > map_.log_odds_.clamp_max) {
-      value = map_.log_odds_.clamp_max;
-    }
-    std::memcpy(&cell, &value, sizeof cell);
-    map_.known_ += was_known ? 0 : 1;
-    const bool occupied = value >= map_.log_odds_.occupied;
-    if (occupied != was_occupied) {
-      if (occupied) {
-        ++map_.occupied_;
-      } else {
-        --map_.occupied_;
-      }
-    }
+    add(map_.store_.block_values(block_of(slot))[v], delta, 1);
     ++counter;
+  }
+
+  // The voxels of a brick the scan's cube visited (ScanWindow), freed but
+  // for those the hits took: a sub-brick freed whole that holds one value
+  // gets the new value as one, the others a dense block as update() does.
+  void free_brick(std::uint64_t brick_key, const std::uint64_t* visited, std::uint32_t& counter) noexcept {
+    const std::uint32_t index = map_.store_.find_or_add(brick_key);
+    if (index == kNone) {
+      for (int z = 0; z < 8; ++z) dropped_ += static_cast<std::uint32_t>(__builtin_popcountll(visited[z]));
+      return;
+    }
+    Brick& b = map_.store_.brick(index);
+    if (b.scan != map_.scan_) {
+      b.scan = map_.scan_;
+      std::memset(b.touched, 0, sizeof b.touched);
+      map_.touched_[map_.touched_count_++] = index;
+    }
+    std::uint64_t frees[8];
+    for (int z = 0; z < 8; ++z) {
+      frees[z] = visited[z] & ~b.touched[z];
+      b.touched[z] |= visited[z];
+    }
+    const float miss = map_.log_odds_.miss;
+    for (int s = 0; s < 8; ++s) {
+      // The sub-brick's 4 x 4 corner of each of its four z-slices.
+      const std::uint64_t quadrant = std::uint64_t{0x0F0F0F0F} << ((s & 1) * 4 + (s >> 1 & 1) * 32);
+      const std::uint64_t* slices = &frees[(s >> 2) * 4];
+      const std::uint64_t q0 = slices[0] & quadrant, q1 = slices[1] & quadrant, q2 = slices[2] & quadrant,
+                          q3 = slices[3] & quadrant;
+      if ((q0 | q1 | q2 | q3) == 0) continue;
+      std::uint32_t slot = b.sub[s];
+      if (!is_dense(slot) && (q0 & q1 & q2 & q3) == quadrant) {
+        add(b.sub[s], miss, kSubVoxels);
+        counter += kSubVoxels;
+        continue;
+      }
+      const std::uint32_t count = static_cast<std::uint32_t>(__builtin_popcountll(q0) + __builtin_popcountll(q1) +
+                                                             __builtin_popcountll(q2) + __builtin_popcountll(q3));
+      if (!is_dense(slot)) {
+        const std::uint32_t block = map_.store_.new_block(slot);
+        if (block == kNone) {
+          dropped_ += count;
+          continue;
+        }
+        slot = b.sub[s] = dense_slot(block);
+      }
+      std::uint32_t* values = map_.store_.block_values(block_of(slot));
+      const std::uint64_t q[4] = {q0, q1, q2, q3};
+      for (int j = 0; j < 4; ++j) {
+        for (std::uint64_t m = q[j]; m != 0; m &= m - 1) {
+          const int bit = __builtin_ctzll(m);  // x & 7 | (y & 7) << 3
+          add(values[(bit & 3) | (bit >> 3 & 3) << 2 | j << 4], miss, 1);
+        }
+      }
+      counter += count;
+    }
   }
 
   // A brick's touched mask and the packed keys (pack()) of its voxels with
@@ -116,6 +156,30 @@ class OccupancyMap::ScanWriter {
   std::uint32_t dropped() const noexcept { return dropped_; }
 
  private:
+  // OctoMap's updateNodeLogOdds on a stored value (a voxel's, or a uniform
+  // sub-brick's standing for `voxels` of them): add, then clamp.
+  void add(std::uint32_t& cell, float delta, std::uint32_t voxels) noexcept {
+    const bool was_known = cell != kUnknownBits;
+    float value = was_known ? float_of(cell) : 0.0f;
+    const bool was_occupied = was_known && value >= map_.log_odds_.occupied;
+    value += delta;
+    if (value < map_.log_odds_.clamp_min) {
+      value = map_.log_odds_.clamp_min;
+    } else if (value > map_.log_odds_.clamp_max) {
+      value = map_.log_odds_.clamp_max;
+    }
+    std::memcpy(&cell, &value, sizeof cell);
+    map_.known_ += was_known ? 0 : voxels;
+    const bool occupied = value >= map_.log_odds_.occupied;
+    if (occupied != was_occupied) {
+      if (occupied) {
+        map_.occupied_ += voxels;
+      } else {
+        map_.occupied_ -= voxels;
+      }
+    }
+  }
+
   OccupancyMap& map_;
   std::uint64_t cached_key_ = kNoBrick;
   std::uint32_t cached_ = kNone;
@@ -170,6 +234,10 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     return result;
   }
 
+  VoxelKey origin_key;
+  if (grid_.key_of(origin, origin_key)) window_.begin(origin_key);
+  const ScanWindow::Probe window = window_.probe();
+
   // Hits first, so the rays below find them marked and leave them alone.
   for (std::size_t i = 0; i < count; ++i) {
     const MapPoint& p = points[i];
@@ -181,6 +249,7 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     VoxelKey key;
     if (grid_.key_of(p, key)) {
       writer.update(key, log_odds_.hit, result.hits);
+      window.visit(pack(key));  // so that no ray frees it
     } else {
       ++result.outside;
     }
@@ -199,7 +268,8 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     recent_base[i] = ~std::uint64_t{0};
     recent_touched[i] = nullptr;
   }
-  const auto free = [&](std::uint64_t packed) __attribute__((always_inline)) {
+  // A voxel outside the scan window.
+  const auto check = [&](std::uint64_t packed) {
     const std::uint64_t base = packed & ScanWriter::kBrickBits;
     const std::size_t slot = recent_slot(packed);
     if (recent_base[slot] == base &&
@@ -210,13 +280,61 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     recent_base[slot] = brick.base;
     recent_touched[slot] = brick.touched;
   };
+  // The rays' loop only collects their voxels; the checks run over them in
+  // a loop of their own. Together in one loop they had more live values
+  // than registers, and every step paid spills.
+  constexpr std::size_t kKeyBuffer = 2048;
+  std::uint64_t keys[kKeyBuffer];
+  std::size_t pending = 0;
+  const auto flush = [&]() {
+    const ScanWindow::Probe near = window;  // in registers: the stores below may not alias a local
+    for (std::size_t k = 0; k < pending; ++k) {
+      const std::uint64_t key = keys[k];
+      if (!near.visit(key)) check(key);
+    }
+    pending = 0;
+  };
+  const auto free = [&](std::uint64_t packed) __attribute__((always_inline)) {
+    keys[pending] = packed;
+    if (++pending == kKeyBuffer) flush();
+  };
+  // kFast rays go four at a time through the AVX2 lanes where there are
+  // some (ray_batch.hpp); a lane whose ray ends takes the next one.
+  const bool batch = ray_batch_available();
+  RayState lanes[4] = {};
+  unsigned live = 0;
+  const auto cast = [&](const MapPoint& end) -> bool {
+    detail::RaySetup setup;
+    RayState state{};
+    const RayStart kind = start_ray(grid_, origin, end, state, setup);
+    if (kind == RayStart::kOutside) return false;
+    if (kind == RayStart::kEmpty) return true;
+    free(pack(setup.key_origin));
+    if (kind == RayStart::kExact) {
+      auto visit_key = [&](const VoxelKey& k) { free(pack(k)); };
+      detail::traverse_exact(setup.t_max, setup.t_delta, setup.step, setup.key_origin, setup.key_end, setup.limit,
+                             visit_key);
+    } else if (!batch) {
+      run_ray(state, free);
+    } else {
+      const int lane = __builtin_ctz(~live & 15u);
+      lanes[lane] = state;
+      live |= 1u << lane;
+      while (live == 15u) {
+        if (pending + 4 > kKeyBuffer) flush();
+        pending += step_rays4(lanes, live, window, keys + pending, kKeyBuffer - pending);
+      }
+    }
+    return true;
+  };
   const float range = static_cast<float>(max_range);
   for (std::size_t i = 0; i < count; ++i) {
     const MapPoint& p = points[i];
     if (!is_finite(p)) continue;
     const Offset d = offset_of(p, origin);
+    if (pending > kKeyBuffer / 2) flush();
     if (!limited || d.length <= max_range) {
-      traverse_ray_packed(grid_, origin, p, free);
+      cast(p);
       continue;
     }
     ++result.beyond_range;
@@ -224,9 +342,16 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     const float length = static_cast<float>(d.length);
     const MapPoint end{origin.x + (d.x / length) * range, origin.y + (d.y / length) * range,
                        origin.z + (d.z / length) * range};
-    if (!traverse_ray_packed(grid_, origin, end, free)) ++result.outside;
+    if (!cast(end)) ++result.outside;
   }
-
+  while (live != 0) {
+    if (pending + 4 > kKeyBuffer) flush();
+    pending += step_rays4(lanes, live, window, keys + pending, kKeyBuffer - pending);
+  }
+  flush();
+  window_.drain([&](std::uint64_t brick_key, const std::uint64_t* visited) {
+    writer.free_brick(brick_key, visited, result.frees);
+  });
   result.dropped = writer.dropped();
   dropped_ += result.dropped;
   compact_touched();

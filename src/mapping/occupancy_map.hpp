@@ -22,6 +22,7 @@
 #include "mapping/brick_store.hpp"
 #include "mapping/map_point.hpp"
 #include "mapping/occupancy_params.hpp"
+#include "mapping/scan_window.hpp"
 #include "mapping/voxel_key.hpp"
 
 namespace rtfuse::mapping {
@@ -118,6 +119,7 @@ class OccupancyMap {
   LogOdds log_odds_;
   VoxelGrid grid_;
   BrickStore store_;
+  ScanWindow window_;  // the scan's visited voxels near the sensor
   std::unique_ptr<std::uint32_t[]> touched_;  // bricks touched in this scan
   std::uint32_t touched_count_ = 0;
   std::uint32_t scan_ = 0;
