@@ -49,12 +49,7 @@ class OccupancyMap::ScanWriter {
         ++dropped_;
         return;
       }
-      Brick& b = map_.store_.brick(cached_);
-      if (b.scan != map_.scan_) {
-        b.scan = map_.scan_;
-        std::memset(b.touched, 0, sizeof b.touched);
-        map_.touched_[map_.touched_count_++] = cached_;
-      }
+      begin_brick(cached_);
     }
     Brick& b = map_.store_.brick(cached_);
     std::uint64_t& touched = b.touched[touched_word(key)];
@@ -88,12 +83,7 @@ class OccupancyMap::ScanWriter {
       for (int z = 0; z < 8; ++z) dropped_ += static_cast<std::uint32_t>(__builtin_popcountll(visited[z]));
       return;
     }
-    Brick& b = map_.store_.brick(index);
-    if (b.scan != map_.scan_) {
-      b.scan = map_.scan_;
-      std::memset(b.touched, 0, sizeof b.touched);
-      map_.touched_[map_.touched_count_++] = index;
-    }
+    Brick& b = begin_brick(index);
     std::uint64_t frees[8];
     for (int z = 0; z < 8; ++z) {
       frees[z] = visited[z] & ~b.touched[z];
@@ -156,6 +146,19 @@ class OccupancyMap::ScanWriter {
   std::uint32_t dropped() const noexcept { return dropped_; }
 
  private:
+  // A brick this scan writes: its mask of updated voxels starts empty (a
+  // stamp says whether it already belongs to this scan) and it joins the
+  // list of the scan's bricks.
+  Brick& begin_brick(std::uint32_t index) noexcept {
+    Brick& b = map_.store_.brick(index);
+    if (b.scan != map_.scan_) {
+      b.scan = map_.scan_;
+      std::memset(b.touched, 0, sizeof b.touched);
+      map_.touched_[map_.touched_count_++] = index;
+    }
+    return b;
+  }
+
   // OctoMap's updateNodeLogOdds on a stored value (a voxel's, or a uniform
   // sub-brick's standing for `voxels` of them): add, then clamp.
   void add(std::uint32_t& cell, float delta, std::uint32_t voxels) noexcept {
@@ -304,19 +307,11 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
   RayState lanes[4] = {};
   unsigned live = 0;
   const auto cast = [&](const MapPoint& end) -> bool {
-    detail::RaySetup setup;
-    RayState state{};
-    const RayStart kind = start_ray(grid_, origin, end, state, setup);
-    if (kind == RayStart::kOutside) return false;
-    if (kind == RayStart::kEmpty) return true;
-    free(pack(setup.key_origin));
-    if (kind == RayStart::kExact) {
-      auto visit_key = [&](const VoxelKey& k) { free(pack(k)); };
-      detail::traverse_exact(setup.t_max, setup.t_delta, setup.step, setup.key_origin, setup.key_end, setup.limit,
-                             visit_key);
-    } else if (!batch) {
-      run_ray(state, free);
-    } else {
+    return traverse_ray_with(grid_, origin, end, free, [&](const RayState& state) {
+      if (!batch) {
+        run_ray(state, free);
+        return;
+      }
       const int lane = __builtin_ctz(~live & 15u);
       lanes[lane] = state;
       live |= 1u << lane;
@@ -324,8 +319,7 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
         if (pending + 4 > kKeyBuffer) flush();
         pending += step_rays4(lanes, live, window, keys + pending, kKeyBuffer - pending);
       }
-    }
-    return true;
+    });
   };
   const float range = static_cast<float>(max_range);
   for (std::size_t i = 0; i < count; ++i) {

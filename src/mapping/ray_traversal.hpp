@@ -297,13 +297,11 @@ void run_ray(RayState s, Visit& visit) {
   }
 }
 
-// Calls visit(std::uint64_t packed_key) (pack()) for each voxel from origin
-// towards end, end's voxel excluded. False (nothing visited) when either
-// point is outside the map. The number of voxels is bounded by the
-// segment's length over the resolution (at most three steps per voxel
-// length).
-template <class Visit>
-bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
+// As traverse_ray_packed, but a kFast ray's voxels after the origin's are
+// left to run(const RayState&) (run_ray, or another stepper that gives the
+// same voxels).
+template <class Visit, class Run>
+bool traverse_ray_with(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit& visit, Run&& run) {
   detail::RaySetup setup;
   RayState state{};
   const RayStart kind = start_ray(grid, origin, end, state, setup);
@@ -316,8 +314,18 @@ bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const Ma
                            visit_key);
     return true;
   }
-  run_ray(state, visit);
+  run(state);
   return true;
+}
+
+// Calls visit(std::uint64_t packed_key) (pack()) for each voxel from origin
+// towards end, end's voxel excluded. False (nothing visited) when either
+// point is outside the map. The number of voxels is bounded by the
+// segment's length over the resolution (at most three steps per voxel
+// length).
+template <class Visit>
+bool traverse_ray_packed(const VoxelGrid& grid, const MapPoint& origin, const MapPoint& end, Visit&& visit) {
+  return traverse_ray_with(grid, origin, end, visit, [&](const RayState& state) { run_ray(state, visit); });
 }
 
 // As traverse_ray_packed, calling visit(const VoxelKey&).
