@@ -258,10 +258,10 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     }
   }
 
-  // Most voxels of a ray were freed by an earlier ray of the scan (6 M
-  // visits for 0.3 M voxels on scan.dat at 0.1 m within 10 m), and a ray
-  // changes brick every seven voxels or so, at a coin toss, mostly to one
-  // an earlier ray used. So a visit is checked against a small
+  // Voxels beyond the window (rays without a range limit) are applied at
+  // once. Most of them too were visited by an earlier ray of the scan, and
+  // a ray changes brick every seven voxels or so, at a coin toss, mostly to
+  // one an earlier ray used. So such a visit is checked against a small
   // direct-mapped table of the scan's bricks (any 8 x 8 x 4 of them fit),
   // with no branch on a brick change; only a miss or a new voxel takes the
   // call and the brick hash table, whose slots are spread over megabytes.
@@ -271,7 +271,6 @@ ScanResult OccupancyMap::insert_scan(const MapPoint* points, std::size_t count, 
     recent_base[i] = ~std::uint64_t{0};
     recent_touched[i] = nullptr;
   }
-  // A voxel outside the scan window.
   const auto check = [&](std::uint64_t packed) {
     const std::uint64_t base = packed & ScanWriter::kBrickBits;
     const std::size_t slot = recent_slot(packed);
