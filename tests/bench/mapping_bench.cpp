@@ -2,6 +2,11 @@
 // docs/performance.md; the insertion itself is measured against OctoMap in
 // rtfuse_bench_octomap.
 //
+//   BM_MapInsertRoom       one scan of the room (40,000 rays, 6 m range,
+//                          0.05 m) into a map already holding its earlier
+//                          scans, the mapper's steady state: the stage that
+//                          runs four rays at a time where the CPU has AVX2,
+//                          one at a time on aarch64
 //   BM_DisparityPoints     a VGA pair's half-resolution disparity (320 x 240,
 //                          a slanted plane 1-6 m away) back-projected and
 //                          carried into the map frame
@@ -128,6 +133,22 @@ void BM_ScanViews(benchmark::State& state) {
   state.counters["allocs_per_iter"] = static_cast<double>(allocations) / static_cast<double>(state.iterations());
 }
 
+void BM_MapInsertRoom(benchmark::State& state) {
+  mapping::OccupancyMap map(five_cm(), mapping::capacity_for_bytes(std::size_t{256} << 20));
+  map_rooms(map, 1);
+  const std::vector<mapping::MapPoint> scan = room_scan();
+  std::size_t allocations = 0;
+  int s = 0;
+  for (auto _ : state) {
+    rtfuse::test::AllocScope scope;
+    benchmark::DoNotOptimize(map.insert_scan(scan.data(), scan.size(), {0.5f * (s++ % 4), 0.0f, 0.4f}, 6.0));
+    allocations += scope.count();
+  }
+  state.counters["rays"] = static_cast<double>(scan.size());
+  state.counters["allocs_per_iter"] = static_cast<double>(allocations) / static_cast<double>(state.iterations());
+}
+
+BENCHMARK(BM_MapInsertRoom)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_DisparityPoints)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_GridProjection)->Arg(200)->Arg(400)->Unit(benchmark::kMillisecond);
 BENCHMARK(BM_MapDigest)->Arg(1)->Arg(8)->Unit(benchmark::kMillisecond);
