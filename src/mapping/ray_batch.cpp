@@ -38,8 +38,6 @@ void scatter(RayState* r, std::size_t offset, __m256i v) noexcept {
 // The selects. blendv takes b where the mask's lane is set.
 inline __m256i pick(__m256i mask, __m256i b, __m256i a) noexcept { return _mm256_blendv_epi8(a, b, mask); }
 
-}  // namespace
-
 // The emitted lanes to the front, as 32-bit halves: for each 4-bit mask of
 // lanes, the permutation and how many.
 struct Compaction {
@@ -62,6 +60,8 @@ constexpr Compaction make_compaction() {
   return c;
 }
 constexpr Compaction kCompaction = make_compaction();
+
+}  // namespace
 
 std::size_t step_rays4(RayState* rays, unsigned& live, const ScanWindow::Probe& window, std::uint64_t* out,
                        std::size_t capacity) noexcept {

@@ -11,8 +11,8 @@
 //
 // The cube is laid out as the map's bricks (eight 64-bit z-slices of x, y
 // bits), so a window brick is a map brick's touched mask. Keys are shifted
-// by a multiple of 8 per axis that puts the origin within 4 voxels of the
-// cube's centre, so the cube holds at least 121 voxels on every side of it
+// by a multiple of 8 per axis that puts the origin's voxel at 121 to 128 in
+// the cube's 256, so the cube holds at least 121 voxels on every side of it
 // (6 m at 0.05 m, 12 m at 0.1 m); a voxel outside says so and takes the
 // brick table instead. Whether a key is inside is decided exactly (the
 // high byte of each shifted axis), never assumed from the range.
@@ -20,6 +20,7 @@
 #include <cstdint>
 #include <memory>
 
+#include "mapping/brick_store.hpp"
 #include "mapping/voxel_key.hpp"
 
 namespace rtfuse::mapping {
@@ -31,9 +32,10 @@ class ScanWindow {
 
   ScanWindow() : bits_(new std::uint64_t[kWords]()), summary_(new std::uint64_t[kSummaryWords]()) {}
 
-  // Centres the cube on the origin's voxel for one scan (until drain()); an origin within
-  // 512 voxels of the key space's edge gets no cube (every key is outside),
-  // so a shifted axis can never carry into the next one unnoticed.
+  // Centres the cube on the origin's voxel for one scan (until drain());
+  // an origin within 512 voxels of the key space's edge gets no cube
+  // (every key is outside), so a shifted axis can never carry into the
+  // next one unnoticed.
   void begin(const VoxelKey& origin) noexcept {
     shift_ = 0;
     tag_ = kNever;
@@ -122,15 +124,17 @@ class ScanWindow {
   static constexpr std::size_t kSummaryWords = kWords / 8 / 64;
   static constexpr std::uint64_t kNever = 1;  // no key masked by kHighBytes equals it
 
+  // The map's brick (brick_key_of) of a brick of the cube: its first
+  // voxel's key, unshifted.
   std::uint64_t brick_key_of_window(std::size_t brick) const noexcept {
-    std::uint64_t key = 0;
+    VoxelKey first;
     for (int axis = 0; axis < 3; ++axis) {
       const std::uint64_t low = (brick >> (5 * axis) & 31) << 3;
       const std::uint64_t high = tag_ >> (16 * axis) & 0xFF00;
       const std::uint64_t s = shift_ >> (16 * axis) & 0xFF;
-      key |= ((high | low) - s) >> 3 << (13 * axis);
+      first.k[axis] = static_cast<std::uint16_t>((high | low) - s);
     }
-    return key;
+    return brick_key_of(first);
   }
 
   std::unique_ptr<std::uint64_t[]> bits_;     // word (z & 7 | brick << 3), bit x & 7 | (y & 7) << 3
