@@ -47,6 +47,8 @@ constexpr std::uint64_t kWheelSlip = 0x100;  // + wheel index
 constexpr std::uint64_t kGyro = 0x200;       // + axis
 constexpr std::uint64_t kAccel = 0x300;      // + axis
 constexpr std::uint64_t kGnss = 0x400;       // + 0..2 bias axes, 3..5 noise axes, 6..8 multipath
+constexpr std::uint64_t kGyroVibration = 0x500;   // + axis
+constexpr std::uint64_t kAccelVibration = 0x600;  // + axis
 }  // namespace stream
 
 }  // namespace rtfuse::sim

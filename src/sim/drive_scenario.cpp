@@ -433,7 +433,7 @@ void read_triple(const Section& s, std::string_view k, double scale, std::array<
 void read_imu(const Section& s, SimImuConfig& imu) {
   s.reject_unknown({"model", "address", "rate_hz", "gyro_range_dps", "accel_range_g", "gyro_noise_density_dps_rthz",
                     "accel_noise_density_ug_rthz", "gyro_bias_dps", "accel_bias_mps2", "xyz_m", "rpy_deg",
-                    "temperature_c"});
+                    "temperature_c", "vibration_accel_mps2", "vibration_gyro_dps", "vibration_speed_mps"});
   switch (read_choice(s, "model", {"mpu6050", "mpu6500", "mpu9250"})) {
     case 1: imu.model = MpuChip::kMpu6500; break;
     case 2: imu.model = MpuChip::kMpu9250; break;
@@ -473,6 +473,15 @@ void read_imu(const Section& s, SimImuConfig& imu) {
   }
   read_number(s, "temperature_c", imu.temperature_c, [](double v) { return v >= -40.0 && v <= 85.0; },
               "must be within the chip's -40..85 C");
+  read_number(s, "vibration_accel_mps2", imu.vibration_accel_mps2, [](double v) { return v >= 0.0 && v <= 20.0; },
+              "must be 0..20 m/s^2 (a Jackal driving: about 0.3)");
+  double dps = 0.0;
+  if (read_number(s, "vibration_gyro_dps", dps, [](double v) { return v >= 0.0 && v <= 100.0; },
+                  "must be 0..100 deg/s (a Jackal driving: about 1)")) {
+    imu.vibration_gyro_rad_s = dps * kDeg;
+  }
+  read_number(s, "vibration_speed_mps", imu.vibration_speed_mps, in_range(0.0, 10.0),
+              "must be > 0 and <= 10 m/s");
 }
 
 void read_gnss(const Section& s, SimGnssConfig& g) {

@@ -32,6 +32,7 @@ SimImu::SimImu(const DriveScenario& scenario, TruthSource& truth, hal::Clock& cl
       // band up to Nyquist (the DLPF's band would be a refinement).
       gyro_sigma_(scenario.imu.gyro_noise_density * std::sqrt(0.5 * 1e9 / period_ns_)),
       accel_sigma_(scenario.imu.accel_noise_density * std::sqrt(0.5 * 1e9 / period_ns_)),
+      half_track_m_(0.5 * scenario.robot.track_width_m),
       chip_(scenario.imu.model) {
   const Eigen::Matrix3d r = geometry::rotation_from_rpy(cfg_.rpy_rad[0], cfg_.rpy_rad[1], cfg_.rpy_rad[2]);
   for (int i = 0; i < 3; ++i) {
@@ -55,7 +56,10 @@ std::int64_t SimImu::first_sample_at_or_after(TimeNs t) const noexcept {
 }
 
 ImuChipReading SimImu::ideal_sample(std::int64_t k) const noexcept {
-  const TruthState s = truth_.truth_at(ns_to_sec(sample_time(k) - t0_));
+  return reading_of(truth_.truth_at(ns_to_sec(sample_time(k) - t0_)));
+}
+
+ImuChipReading SimImu::reading_of(const TruthState& s) const noexcept {
   const double w = s.yaw_rate;
   const double dw = s.yaw_accel;
   const double px = cfg_.xyz_m[0];
@@ -75,8 +79,20 @@ ImuChipReading SimImu::ideal_sample(std::int64_t k) const noexcept {
   return out;
 }
 
+// The wheels shake the base in proportion to how fast they roll, so a turn
+// on the spot shakes it as driving does; the fastest wheel of a
+// differential or skid-steer base rolls at |v| + |w| * track / 2.
+double SimImu::vibration_share(const TruthState& s) const noexcept {
+  const double wheel_speed = std::abs(s.speed) + std::abs(s.yaw_rate) * half_track_m_;
+  return std::min(1.0, wheel_speed / cfg_.vibration_speed_mps);
+}
+
 ImuChipReading SimImu::sample(std::int64_t k) const noexcept {
-  ImuChipReading s = ideal_sample(k);
+  const TruthState truth = truth_.truth_at(ns_to_sec(sample_time(k) - t0_));
+  ImuChipReading s = reading_of(truth);
+  const double shake = vibration_share(truth);
+  const double gyro_shake = shake * cfg_.vibration_gyro_rad_s;
+  const double accel_shake = shake * cfg_.vibration_accel_mps2;
   const auto index = static_cast<std::uint64_t>(k);
   for (int i = 0; i < 3; ++i) {
     const auto axis = static_cast<std::uint64_t>(i);
@@ -84,6 +100,12 @@ ImuChipReading SimImu::sample(std::int64_t k) const noexcept {
                        gyro_sigma_ * counter_normal(seed_, stream::kGyro + axis, index);
     s.accel_mps2[i] += cfg_.accel_bias_mps2[static_cast<std::size_t>(i)] +
                        accel_sigma_ * counter_normal(seed_, stream::kAccel + axis, index);
+    // Drawn only when there is vibration, so a vibration-free scenario's
+    // samples stay what they were.
+    if (gyro_shake > 0.0) s.gyro_rad_s[i] += gyro_shake * counter_normal(seed_, stream::kGyroVibration + axis, index);
+    if (accel_shake > 0.0) {
+      s.accel_mps2[i] += accel_shake * counter_normal(seed_, stream::kAccelVibration + axis, index);
+    }
   }
   return s;
 }

@@ -7,9 +7,9 @@
 // Sample k is taken at t_k = t0 + k / rate. wait_edge() sleeps (through the
 // clock) until the next t_k, latches the true specific force and angular
 // rate at t_k into the registers, in the IMU frame of the scenario's
-// mounting, with the constant biases and white noise added (the register
-// file quantises and saturates as the chip does), and returns the edge
-// stamped t_k. Samples while the chip sleeps or has DATA_RDY_EN off raise no
+// mounting, with the constant biases, white noise and the rolling base's
+// vibration added (the register file quantises and saturates as the chip
+// does), and returns the edge stamped t_k. Samples while the chip sleeps or has DATA_RDY_EN off raise no
 // edge, as on the chip.
 //
 // Noise of sample k is counter-based (seed, axis, k): a sample's value does
@@ -58,7 +58,7 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimD
   void provide(DeviceBuses& out, hal::Clock& clock) noexcept override;
   TimeNs next_event_time() noexcept override { return next_edge_time(); }
   TimeNs sample_time(std::int64_t k) const noexcept;
-  // Sample k as the chip's sensors see it, noise and bias included.
+  // Sample k as the chip's sensors see it, noise, vibration and bias included.
   ImuChipReading sample(std::int64_t k) const noexcept;
   // The noise-free value of the same (truth through the mounting).
   ImuChipReading ideal_sample(std::int64_t k) const noexcept;
@@ -101,6 +101,9 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimD
 
  private:
   std::int64_t first_sample_at_or_after(TimeNs t) const noexcept;
+  ImuChipReading reading_of(const TruthState& s) const noexcept;
+  // 0..1: how much of the configured vibration the base's motion excites.
+  double vibration_share(const TruthState& s) const noexcept;
 
   TruthSource& truth_;
   hal::Clock& clock_;
@@ -110,6 +113,7 @@ class SimImu final : public hal::I2cBus, public hal::GpioEdgeSource, public SimD
   double period_ns_;
   double gyro_sigma_;
   double accel_sigma_;
+  double half_track_m_;
   double r_[3][3] = {};  // base_link <- IMU rotation of the mounting
 
   hal::mock::MockI2cBus bus_;

@@ -177,6 +177,9 @@ accel_bias_mps2 = [0.1, 0.2, 0.3]
 xyz_m = [0.1, 0.2, 0.3]
 rpy_deg = [180.0, 0.0, 90.0]
 temperature_c = 40.0
+vibration_accel_mps2 = 0.4
+vibration_gyro_dps = 2.0
+vibration_speed_mps = 0.5
 )");
   const RobotBody& r = sc.robot;
   EXPECT_EQ(r.kinematics, DriveKinematics::kSkidSteer);
@@ -222,6 +225,9 @@ temperature_c = 40.0
   EXPECT_DOUBLE_EQ(imu.rpy_rad[0], kPi);
   EXPECT_DOUBLE_EQ(imu.rpy_rad[2], 0.5 * kPi);
   EXPECT_EQ(imu.temperature_c, 40.0);
+  EXPECT_EQ(imu.vibration_accel_mps2, 0.4);
+  EXPECT_DOUBLE_EQ(imu.vibration_gyro_rad_s, 2.0 * kDeg);
+  EXPECT_EQ(imu.vibration_speed_mps, 0.5);
 }
 
 TEST(DriveScenario, UnknownKeysAreErrorsWithLineColumnAndSuggestion) {
@@ -278,6 +284,8 @@ right_nodes = [2]
 [imu]
 gyro_range_dps = 300
 address = 0x80
+vibration_speed_mps = 0.0
+vibration_accel_mps2 = -0.3
 )");
   EXPECT_NE(e.find("t.toml:2:18: limits.max_accel_mps2: must be > 0 and <= 20 m/s^2, got -1"), std::string::npos) << e;
   EXPECT_NE(e.find("t.toml:6:13: path[0].angle_deg: must be non-zero"), std::string::npos) << e;
@@ -287,6 +295,12 @@ address = 0x80
   EXPECT_NE(e.find("t.toml:13:18: imu.gyro_range_dps: must be 250, 500, 1000 or 2000, got 300"), std::string::npos)
       << e;
   EXPECT_NE(e.find("t.toml:14:11: imu.address: must be between 8 and 119, got 128"), std::string::npos) << e;
+  EXPECT_NE(e.find("t.toml:15:23: imu.vibration_speed_mps: must be > 0 and <= 10 m/s, got 0"), std::string::npos)
+      << e;
+  EXPECT_NE(e.find("t.toml:16:24: imu.vibration_accel_mps2: must be 0..20 m/s^2 (a Jackal driving: about 0.3), got "
+                   "-0.3"),
+            std::string::npos)
+      << e;
 }
 
 TEST(DriveScenario, InconsistentEntriesAreErrors) {
