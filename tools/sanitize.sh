@@ -63,14 +63,15 @@ case "$kind" in
     # the obstacle course (50 s here): it scores depth and map against the
     # world's truth; its renderer, matcher and map run here in the rendered
     # pairs' tests and the mapper's lockstep drive. And the navigator's
-    # closed loop (30 s natively, minutes here): its navigator runs here in
+    # closed loop (30 s natively, minutes here) and its whole obstacle
+    # course (65 s natively): its navigator runs here in
     # its own unit tests and in the daemon fuzzer, its drive in the
     # mapper's and the commanded base's lockstep drives. And the planner
     # against Boost on the mapped obstacle course: it maps the lap as the
     # accuracy test does (left to the native stage above), then compares
     # plans, which the random grids' comparison does here.
     (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference \
-      -E '^(integration_gnss_drive|integration_camera_slip|integration_plain_wall|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays|BoostGraphReference\.TheMappedObstacleCourseGivesBoostsCostsToo)$' "$@")
+      -E '^(integration_gnss_drive|integration_camera_slip|integration_plain_wall|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays|NavDrive\.TheObstacleCoursesTenGoalsEachReachedWithinAFootOfTheTruth|BoostGraphReference\.TheMappedObstacleCourseGivesBoostsCostsToo)$' "$@")
     ;;
   tsan)
     build_tsan

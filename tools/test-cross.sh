@@ -97,9 +97,10 @@ cd "$dir"
 # - the mapper's lockstep drive and its replay (rendering and keyframes: a
 #   minute or more emulated): the map on aarch64 is the cross-architecture
 #   replay's, which compares its digest with the x86-64 one.
-# - the navigator's closed loop and its replay (30 s of camera, map and
-#   plans natively, many minutes emulated): the navigator's own arithmetic
+# - the navigator's closed loop and its replay, and its whole obstacle
+#   course (30 s and 65 s of camera, map and plans natively, many minutes
+#   emulated): the navigator's own arithmetic
 #   on aarch64 is its unit tests' (the same commands whenever its thread
 #   runs, the planner's pinned digest).
 ctest --output-on-failure -j2 -L 'unit|package|cross_arch' \
-  -E '^(HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack|SimCamera\.LockstepDriveRectifiesEveryFrameAtTheConfiguredRate|SimCamera\.RecordedFramesReplayThroughTheDriver|FrameConsumers\.ASlowSecondConsumerDropsPairsButNeverStallsCaptureOrChangesTheOdometry|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|MapperDrive\.LockstepDriveMapsEveryKeyframeAndItsRecordingReplaysTheSameMap|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays)$' "$@"
+  -E '^(HalTermiosSerialPort\.EveryStandardRateIsSetAndReadBack|SimCamera\.LockstepDriveRectifiesEveryFrameAtTheConfiguredRate|SimCamera\.RecordedFramesReplayThroughTheDriver|FrameConsumers\.ASlowSecondConsumerDropsPairsButNeverStallsCaptureOrChangesTheOdometry|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|MapperDrive\.LockstepDriveMapsEveryKeyframeAndItsRecordingReplaysTheSameMap|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays|NavDrive\.TheObstacleCoursesTenGoalsEachReachedWithinAFootOfTheTruth)$' "$@"

@@ -97,4 +97,37 @@ TEST(NavDrive, FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays) {
   EXPECT_EQ(replay.final.nav.plan_seq, d.final.nav.plan_seq);
 }
 
+// The closed loop: the whole obstacle course as config/sim_nav.toml
+// drives it, ten goals in turn from an empty map, each reached within 0.3 m
+// of the truth, never nearer an obstacle than the footprint's radius, and
+// re-planned when the map shows the path blocked. The scenario's 240 s are
+// cut to 180: its last goal is reached after some 160 s. That the closed
+// loop's recording replays is the test above's (this drive's is 7 GB).
+TEST(NavDrive, TheObstacleCoursesTenGoalsEachReachedWithinAFootOfTheTruth) {
+  std::string scenario = read_file(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacle_goals.toml");
+  const std::string from = "duration_s = 240.0";
+  const std::size_t at = scenario.find(from);
+  ASSERT_NE(at, std::string::npos);
+  scenario.replace(at, from.size(), "duration_s = 180.0");
+  sim::DriveOptions options;
+  options.scenario_path = testing::TempDir() + "rtfuse_nav_course_" + std::to_string(::getpid()) + ".toml";
+  std::ofstream(options.scenario_path) << scenario;
+  const std::string config_path = std::string(RTFUSE_SOURCE_DIR) + "/config/sim_nav.toml";
+  options.config_text = read_file(config_path);
+  const ConfigLoadResult r = load_config_string(options.config_text, config_path);
+  ASSERT_TRUE(r.config) << test::config_errors(r);
+  const sim::DriveResult d = sim::run_sim_drive(*r.config, options, nullptr);
+  std::remove(options.scenario_path.c_str());
+  ASSERT_TRUE(d.ok) << d.error;
+  ASSERT_EQ(d.goals.size(), 10u);
+  for (std::size_t i = 0; i < d.goals.size(); ++i) {
+    EXPECT_TRUE(d.goals[i].reached) << "goal " << i + 1 << ": " << d.goals[i].why;
+    EXPECT_LT(d.goals[i].truth_error_m, 0.3) << "goal " << i + 1;
+  }
+  EXPECT_GE(d.min_obstacle_distance_m, 0.25);
+  EXPECT_GE(d.final.nav.replans_blocked, 1) << "the pillars between goals are found after the plans through them";
+  EXPECT_EQ(d.late_commands, 0);
+  EXPECT_EQ(d.history_misses, 0);
+}
+
 }  // namespace nav_drive_test
