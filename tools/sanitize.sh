@@ -71,7 +71,7 @@ case "$kind" in
     # accuracy test does (left to the native stage above), then compares
     # plans, which the random grids' comparison does here.
     (cd "$dir" && ctest --output-on-failure -j2 -L 'unit|integration' -LE reference \
-      -E '^(integration_gnss_drive|integration_camera_slip|integration_plain_wall|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays|NavDrive\.TheObstacleCoursesTenGoalsEachReachedWithinAFootOfTheTruth|BoostGraphReference\.TheMappedObstacleCourseGivesBoostsCostsToo)$' "$@")
+      -E '^(integration_gnss_drive|integration_camera_slip|integration_plain_wall|SimMapAccuracy\.ObstacleCourseAgainstTheWorldsTruth|NavDrive\.FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays|NavDrive\.TheObstacleCoursesTenGoalsEachReachedWithin30CmOfTheTruth|BoostGraphReference\.TheMappedObstacleCourseGivesBoostsCostsToo)$' "$@")
     ;;
   tsan)
     build_tsan

@@ -9,8 +9,8 @@
 // rate at t_k into the registers, in the IMU frame of the scenario's
 // mounting, with the constant biases, white noise and the rolling base's
 // vibration added (the register file quantises and saturates as the chip
-// does), and returns the edge stamped t_k. Samples while the chip sleeps or has DATA_RDY_EN off raise no
-// edge, as on the chip.
+// does), and returns the edge stamped t_k. Samples while the chip sleeps
+// or has DATA_RDY_EN off raise no edge, as on the chip.
 //
 // Noise of sample k is counter-based (seed, axis, k): a sample's value does
 // not depend on which samples were read before it. Live, the clock is the

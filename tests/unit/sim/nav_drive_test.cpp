@@ -103,7 +103,7 @@ TEST(NavDrive, FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays) {
 // re-planned when the map shows the path blocked. The scenario's 240 s are
 // cut to 180: its last goal is reached after some 160 s. That the closed
 // loop's recording replays is the test above's (this drive's is 7 GB).
-TEST(NavDrive, TheObstacleCoursesTenGoalsEachReachedWithinAFootOfTheTruth) {
+TEST(NavDrive, TheObstacleCoursesTenGoalsEachReachedWithin30CmOfTheTruth) {
   std::string scenario = read_file(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacle_goals.toml");
   const std::string from = "duration_s = 240.0";
   const std::size_t at = scenario.find(from);
