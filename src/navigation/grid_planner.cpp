@@ -41,12 +41,10 @@ struct GridPlanner::Node {
   std::uint32_t step() const noexcept { return link & 7u; }
 };
 
-// An open-list entry: the cell's f when it was entered, the cell, and the
-// next entry of its bucket.
+// An open-list entry: the cell (x in the low 16 bits, y in the high) and
+// the next entry of its bucket. Its f is not kept: the bucket says enough.
 struct GridPlanner::Entry {
-  std::int64_t f;
-  std::uint16_t x;
-  std::uint16_t y;
+  std::uint32_t xy;
   std::uint32_t next;
 };
 
@@ -129,9 +127,9 @@ struct GridPlanner::Compacted {
 
 // Drops the entries no cell points to any more (older entries of cells
 // improved since, and cells already expanded) from the buckets to the
-// free list. At most one entry per cell is left, so a pool larger than the
-// grid always gains room; a smaller one may not, and the search then ends
-// (kOpenListFull). Takes and returns values, so that the search's
+// free list. At most one entry per cell is left, so a pool 8 larger than
+// the grid always gains room for an expansion; a smaller one may not, and
+// the search then ends (kOpenListFull). Takes and returns values, so that the search's
 // counters stay in registers (their addresses never taken).
 GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t stamp, std::uint32_t buckets,
                                             std::uint32_t free_list, std::uint32_t live) noexcept {
@@ -143,7 +141,7 @@ GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t sta
     while (*link != kNoEntry) {
       const std::uint32_t idx = *link;
       Entry& e = pool[idx];
-      const Node& n = nodes[static_cast<std::uint32_t>(e.y) * row + e.x];
+      const Node& n = nodes[(e.xy >> 16) * row + (e.xy & 0xFFFFu)];
       if (n.stamp == stamp && n.entry() == idx) {
         link = &e.next;
       } else {
@@ -211,52 +209,37 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   std::uint32_t unused = 0;  // entries never used yet start here
   std::uint32_t live = 0;    // entries in the buckets
   bool full = false;         // an open list smaller than the grid held only needed entries
-  // The goal's cost so far: an upper bound. Entries at or above it cannot
-  // lead to a cheaper route and are neither entered nor expanded.
+  // The goal's cost so far: an upper bound. Buckets starting at or above it
+  // and entries whose f reaches it cannot lead to a cheaper route: the
+  // former are not taken, the latter not expanded.
   std::int64_t best = INT64_MAX;
 
+  // f never falls along a step (the costs and the heuristic are consistent
+  // exactly, in integers) and rises by at most two of the largest steps
+  // (make_tables()), so an entry's bucket is never behind the one being
+  // taken nor past the window: no clamp. Room for the pushes is made once
+  // an expansion, so a push never checks for it.
   const auto push = [&](int x, int y, std::int64_t f) noexcept -> std::uint32_t {
-    const std::int64_t above = f - f0;
-    std::uint64_t k = above > 0 ? static_cast<std::uint64_t>(above) >> shift : 0;
-    // Never behind the bucket being taken, never past the window (neither
-    // happens with exact consistent costs; an earlier bucket than its f's
-    // would only be taken early, which the search allows).
-    if (k < current) k = current;
-    if (k > current + buckets - 2) k = current + buckets - 2;
-    if (free_list == kNoEntry && unused == pool_size) {
-      const Compacted left = compact(row, stamp, buckets, free_list, live);
-      free_list = left.free_list;
-      live = left.live;
-      if (free_list == kNoEntry) {
-        full = true;
-        return kNoEntry;
-      }
-    }
-    std::uint32_t idx;
-    if (free_list != kNoEntry) {
-      idx = free_list;
+    const auto slot = static_cast<std::uint32_t>(static_cast<std::uint64_t>(f - f0) >> shift) & mask;
+    std::uint32_t idx = free_list;
+    if (idx != kNoEntry) {
       free_list = pool[idx].next;
     } else {
       idx = unused++;
     }
-    const auto slot = static_cast<std::uint32_t>(k) & mask;
-    pool[idx] = Entry{f, static_cast<std::uint16_t>(x), static_cast<std::uint16_t>(y), head[slot]};
+    pool[idx] = Entry{static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16, head[slot]};
     head[slot] = idx;
     ++live;
     return idx;
   };
+  // The goal is entered like any cell; its cost is the best route so far.
   const auto relax = [&](std::uint32_t v, int x, int y, std::int64_t g, std::uint32_t step) noexcept {
     Node& node = nodes[v];
     if (node.stamp == stamp && g >= node.g) return;
     node.stamp = stamp;
     node.g = g;
-    if (v == goal_index) {  // never expanded: nothing beyond it can make it cheaper
-      best = g;
-      node.link = (kNoEntry << 3) | step;
-      return;
-    }
-    const std::int64_t f = g + h_of(x, y);
-    node.link = ((f < best ? push(x, y, f) : kNoEntry) << 3) | step;
+    if (v == goal_index) best = g;
+    node.link = (push(x, y, g + h_of(x, y)) << 3) | step;
   };
 
   const std::uint32_t start_index = static_cast<std::uint32_t>(start.y) * row + static_cast<std::uint32_t>(start.x);
@@ -264,7 +247,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   nodes[start_index].g = 0;
   nodes[start_index].link = push(start.x, start.y, f0) << 3;
   std::size_t expansions = 0;
-  while (live > 0 && !full) {
+  while (live > 0) {
     const std::uint32_t slot = static_cast<std::uint32_t>(current) & mask;
     const std::uint32_t idx = head[slot];
     if (idx == kNoEntry) {  // the bucket is done: stop once the next starts at the goal's cost
@@ -277,16 +260,28 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     pool[idx].next = free_list;
     free_list = idx;
     --live;
-    const int x = e.x;
-    const int y = e.y;
+    const int x = static_cast<int>(e.xy & 0xFFFFu);
+    const int y = static_cast<int>(e.xy >> 16);
     const std::uint32_t u = static_cast<std::uint32_t>(y) * row + static_cast<std::uint32_t>(x);
     Node& node = nodes[u];
     if (node.entry() != idx) continue;  // an older entry of a cell improved since
     node.link |= kNoEntry << 3;
-    if (e.f >= best) continue;
+    const std::int64_t g = node.g;
+    // Once the goal has a route, an entry at or above its cost cannot lead
+    // to a cheaper one (the goal's own entry among them: it is never
+    // expanded).
+    if (best != INT64_MAX && g + h_of(x, y) >= best) continue;
+    if (pool_size - live < 8) {  // room for this expansion's pushes: entries not in a bucket
+      const Compacted left = compact(row, stamp, buckets, free_list, live);
+      free_list = left.free_list;
+      live = left.live;
+      if (pool_size - live < 8) {
+        full = true;
+        break;
+      }
+    }
     ++expansions;
     const std::uint8_t* const c = cost + u;
-    const std::int64_t g = node.g;
     // The orthogonal neighbours' passability (false outside the grid)
     // decides the diagonals too: no step past a blocked corner.
     const bool east = x + 1 < width && passable[c[1]];

@@ -106,8 +106,9 @@ class GridPlanner {
   // open_entries sizes the open list (0: twice the workspace's cells). A
   // search that fills it drops the entries it no longer needs (older
   // entries of cells improved since) and goes on; the list never holds
-  // more than one needed entry per cell, so one larger than the grid
-  // never runs out. A smaller one (tests) can: kOpenListFull.
+  // more than one needed entry per cell and an expansion wants room for
+  // 8 more, so one 8 larger than the grid never runs out. A smaller one
+  // (tests) can: kOpenListFull.
   GridPlanner(int max_width, int max_height, std::size_t max_path_cells, std::size_t open_entries = 0);
   ~GridPlanner();
   GridPlanner(const GridPlanner&) = delete;
