@@ -15,8 +15,12 @@ constexpr std::uint32_t kNoEntry = 0x1FFFFFFFu;
 constexpr std::uint32_t kMaxBuckets = 8192;
 constexpr int kFractionBits = 32;
 constexpr int kBucketBits = 4;  // buckets 1/16 of a cell wide
-// Every f of a search stays below this, so no sum overflows.
-constexpr double kFixedPointLimit = 4.0e18;
+// Every f of a search stays below 2^55 (so no sum overflows), and a plan's
+// costs are kept offset by (kPlansPerEpoch - plan) * 2^56 (Node).
+constexpr double kFixedPointLimit = 3.6e16;
+constexpr int kEpochShift = 56;
+constexpr std::uint32_t kPlansPerEpoch = 127;
+constexpr std::int64_t kNeverReached = INT64_MAX;
 
 // The 8 steps: the four orthogonal first (E, N, W, S), then the diagonals
 // (NE, NW, SW, SE), each between two of them.
@@ -29,12 +33,15 @@ bool inside(const CostView& grid, GridCell c) noexcept {
 
 }  // namespace
 
-// A cell's state in the plan whose stamp it holds: its cost from the start
-// (fixed point), its newest open-list entry (kNoEntry when it has none
-// waiting) and the step that reached it, in one word.
+// A cell's state: its cost from the start (fixed point) offset by the
+// plan's epoch base, its newest open-list entry (kNoEntry when it has none
+// waiting) and the step that reached it, in one word. The base falls by
+// 2^56 from one plan to the next while every cost stays below 2^55, so a
+// cell last reached in an earlier plan holds more than any cost of this
+// one: "not reached yet" and "reached at a higher cost" are one compare,
+// and nothing is cleared between plans but once every 127 plans.
 struct GridPlanner::Node {
   std::int64_t g;
-  std::uint32_t stamp;
   std::uint32_t link;  // entry << 3 | step
 
   std::uint32_t entry() const noexcept { return link >> 3; }
@@ -70,7 +77,7 @@ GridPlanner::GridPlanner(int max_width, int max_height, std::size_t max_path_cel
                                 " entries: at most 2^29 - 2");
   }
   nodes_.reset(new Node[cells_]);
-  for (std::size_t i = 0; i < cells_; ++i) nodes_[i] = Node{0, 0, kNoEntry << 3};
+  for (std::size_t i = 0; i < cells_; ++i) nodes_[i] = Node{kNeverReached, kNoEntry << 3};
   pool_.reset(new Entry[pool_size_]);
   head_.reset(new std::uint32_t[kMaxBuckets]);
   path_.reset(new GridCell[max_path_]);
@@ -112,11 +119,15 @@ void GridPlanner::make_tables(const PlannerParams& params, std::size_t cells) no
   while (static_cast<double>(buckets_) < std::ldexp(spread, bits - shift) + 4.0) buckets_ *= 2;
 }
 
-void GridPlanner::next_stamp() noexcept {
-  if (++stamp_ == 0) {  // after 2^32 - 1 plans: once, forget every stamp
-    for (std::size_t i = 0; i < cells_; ++i) nodes_[i].stamp = 0;
-    stamp_ = 1;
+void GridPlanner::next_plan() noexcept {
+  if (++plan_ > kPlansPerEpoch) {  // the bases are used up: forget every cost
+    for (std::size_t i = 0; i < cells_; ++i) nodes_[i].g = kNeverReached;
+    plan_ = 1;
   }
+}
+
+std::int64_t GridPlanner::base() const noexcept {
+  return static_cast<std::int64_t>(kPlansPerEpoch - plan_) << kEpochShift;
 }
 
 // What compact() leaves: the free entries' list and how many are in use.
@@ -131,7 +142,7 @@ struct GridPlanner::Compacted {
 // the grid always gains room for an expansion; a smaller one may not, and
 // the search then ends (kOpenListFull). Takes and returns values, so that the search's
 // counters stay in registers (their addresses never taken).
-GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t stamp, std::uint32_t buckets,
+GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t buckets,
                                             std::uint32_t free_list, std::uint32_t live) noexcept {
   ++compactions_;
   Entry* const pool = pool_.get();
@@ -142,7 +153,7 @@ GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t sta
       const std::uint32_t idx = *link;
       Entry& e = pool[idx];
       const Node& n = nodes[(e.xy >> 16) * row + (e.xy & 0xFFFFu)];
-      if (n.stamp == stamp && n.entry() == idx) {
+      if (n.entry() == idx) {
         link = &e.next;
       } else {
         *link = e.next;
@@ -198,11 +209,11 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   Entry* const pool = pool_.get();
   std::uint32_t* const head = head_.get();
   const auto pool_size = static_cast<std::uint32_t>(pool_size_);
-  const std::uint32_t stamp = stamp_;
   const std::uint32_t buckets = buckets_;
   const std::uint32_t mask = buckets - 1;
   const int shift = bucket_shift_;
-  const std::int64_t f0 = h_of(start.x, start.y);  // bucket 0 begins at the start's f
+  const std::int64_t g0 = base();                      // costs are kept offset by it
+  const std::int64_t f0 = g0 + h_of(start.x, start.y);  // bucket 0 begins at the start's f
   for (std::uint32_t k = 0; k < buckets; ++k) head[k] = kNoEntry;
   std::uint64_t current = 0;  // the bucket being taken, counted from bucket 0 (not modulo)
   std::uint32_t free_list = kNoEntry;
@@ -235,16 +246,14 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   // The goal is entered like any cell; its cost is the best route so far.
   const auto relax = [&](std::uint32_t v, int x, int y, std::int64_t g, std::uint32_t step) noexcept {
     Node& node = nodes[v];
-    if (node.stamp == stamp && g >= node.g) return;
-    node.stamp = stamp;
+    if (g >= node.g) return;
     node.g = g;
     if (v == goal_index) best = g;
     node.link = (push(x, y, g + h_of(x, y)) << 3) | step;
   };
 
   const std::uint32_t start_index = static_cast<std::uint32_t>(start.y) * row + static_cast<std::uint32_t>(start.x);
-  nodes[start_index].stamp = stamp;
-  nodes[start_index].g = 0;
+  nodes[start_index].g = g0;
   nodes[start_index].link = push(start.x, start.y, f0) << 3;
   std::size_t expansions = 0;
   while (live > 0) {
@@ -272,7 +281,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     // expanded).
     if (best != INT64_MAX && g + h_of(x, y) >= best) continue;
     if (pool_size - live < 8) {  // room for this expansion's pushes: entries not in a bucket
-      const Compacted left = compact(row, stamp, buckets, free_list, live);
+      const Compacted left = compact(row, buckets, free_list, live);
       free_list = left.free_list;
       live = left.live;
       if (pool_size - live < 8) {
@@ -336,7 +345,7 @@ PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal
   std::size_t cells = 1;
   if (start != goal) {
     make_tables(params, static_cast<std::size_t>(grid.width) * static_cast<std::size_t>(grid.height));
-    next_stamp();
+    next_plan();
     const bool found = params.mode == SearchMode::kAStar ? search<true>(grid, start, goal, result)
                                                          : search<false>(grid, start, goal, result);
     if (!found) {
@@ -355,9 +364,9 @@ PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal
     }
     if (cells > max_path_) {
       result.status = PlanStatus::kPathTooLong;
-      result.cost = std::ldexp(static_cast<double>(nodes_[static_cast<std::size_t>(goal.y) * row +
-                                                          static_cast<std::size_t>(goal.x)].g),
-                               -fraction_bits_);
+      const std::int64_t g =
+          nodes_[static_cast<std::size_t>(goal.y) * row + static_cast<std::size_t>(goal.x)].g - base();
+      result.cost = std::ldexp(static_cast<double>(g), -fraction_bits_);
       return result;
     }
     // ...then write start to goal.

@@ -45,8 +45,10 @@
 // Fixed workspace: everything is allocated by the constructor for grids up
 // to max_width x max_height and paths up to max_path_cells; plan()
 // allocates nothing and never throws. A search keeps no state between
-// plans: a per-cell stamp says which plan last saw the cell, so nothing
-// the size of the grid is cleared per plan either.
+// plans: each plan's costs are offset by a base that falls from one plan
+// to the next, so a cell's cost from an earlier plan reads as "not reached
+// yet" and nothing the size of the grid is cleared but once every 127
+// plans.
 #include <cstddef>
 #include <cstdint>
 #include <memory>
@@ -61,8 +63,8 @@ namespace rtfuse::navigation {
 // sqrt(2) rounded to the nearest double (what std::sqrt(2.0) gives).
 inline constexpr double kSqrt2 = 1.4142135623730951;
 // Weights above this are refused. The fixed point keeps 32 fraction bits
-// unless a route on the grid could then overflow 62 bits (weight 2: grids
-// of over 100 M cells; weight 1000: over 320 000), then fewer, 22 at least.
+// unless a route on the grid could then pass 2^55 (weight 2: grids of over
+// 980 000 cells; weight 1000: over 2 900), then fewer, 15 at least.
 inline constexpr double kMaxCostWeight = 1000.0;
 
 enum class SearchMode : std::uint8_t {
@@ -133,22 +135,22 @@ class GridPlanner {
   struct Compacted;
 
   void make_tables(const PlannerParams& params, std::size_t cells) noexcept;
-  void next_stamp() noexcept;
+  void next_plan() noexcept;
+  std::int64_t base() const noexcept;
   template <bool kAStar>
   bool search(const CostView& grid, GridCell start, GridCell goal, PlanResult& result) noexcept;
-  Compacted compact(std::uint32_t row, std::uint32_t stamp, std::uint32_t buckets, std::uint32_t free_list,
-                    std::uint32_t live) noexcept;
+  Compacted compact(std::uint32_t row, std::uint32_t buckets, std::uint32_t free_list, std::uint32_t live) noexcept;
 
   int max_width_;
   int max_height_;
   std::size_t max_path_;
   std::size_t cells_;
   std::size_t pool_size_;
-  std::unique_ptr<Node[]> nodes_;           // per cell: g, stamp, its newest entry and step
+  std::unique_ptr<Node[]> nodes_;           // per cell: g (offset by the plan's base), its newest entry and step
   std::unique_ptr<Entry[]> pool_;           // the open list's entries, linked in buckets
   std::unique_ptr<std::uint32_t[]> head_;   // per bucket: its newest entry
   std::unique_ptr<GridCell[]> path_;
-  std::uint32_t stamp_ = 0;
+  std::uint32_t plan_ = 0;  // 1..127 in an epoch of plans (Node)
   std::size_t compactions_ = 0;
   // Per plan: by cell cost, passable or not, the factor, the straight and
   // diagonal steps in fixed point; the fixed point's fraction bits and the
