@@ -130,20 +130,19 @@ std::int64_t GridPlanner::base() const noexcept {
   return static_cast<std::int64_t>(kPlansPerEpoch - plan_) << kEpochShift;
 }
 
-// What compact() leaves: the free entries' list and how many are in use.
+// What compact() leaves: the free entries' list.
 struct GridPlanner::Compacted {
   std::uint32_t free_list;
-  std::uint32_t live;
 };
 
 // Drops the entries no cell points to any more (older entries of cells
 // improved since, and cells already expanded) from the buckets to the
 // free list. At most one entry per cell is left, so a pool 8 larger than
 // the grid always gains room for an expansion; a smaller one may not, and
-// the search then ends (kOpenListFull). Takes and returns values, so that the search's
-// counters stay in registers (their addresses never taken).
+// the search then ends (kOpenListFull). Takes and returns values, so that
+// the search's counters stay in registers (their addresses never taken).
 GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t buckets,
-                                            std::uint32_t free_list, std::uint32_t live) noexcept {
+                                            std::uint32_t free_list) noexcept {
   ++compactions_;
   Entry* const pool = pool_.get();
   const Node* const nodes = nodes_.get();
@@ -159,11 +158,10 @@ GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t buc
         *link = e.next;
         e.next = free_list;
         free_list = idx;
-        --live;
       }
     }
   }
-  return Compacted{free_list, live};
+  return Compacted{free_list};
 }
 
 // The search: A* (the octile heuristic) or Dijkstra (none), with reopening
@@ -179,6 +177,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   const int gx = goal.x;
   const int gy = goal.y;
   const auto row = static_cast<std::uint32_t>(width);
+  const std::ptrdiff_t w = width;  // a row's stride, in cells and in nodes
   const std::uint32_t goal_index = static_cast<std::uint32_t>(gy) * row + static_cast<std::uint32_t>(gx);
   // The octile distance in the fixed point: hi - lo straight steps and lo
   // diagonal ones of factor 1, each the same integer a step's cost is.
@@ -218,7 +217,6 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   std::uint64_t current = 0;  // the bucket being taken, counted from bucket 0 (not modulo)
   std::uint32_t free_list = kNoEntry;
   std::uint32_t unused = 0;  // entries never used yet start here
-  std::uint32_t live = 0;    // entries in the buckets
   bool full = false;         // an open list smaller than the grid held only needed entries
   // The goal's cost so far: an upper bound. Buckets starting at or above it
   // and entries whose f reaches it cannot lead to a cheaper route: the
@@ -230,7 +228,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   // (make_tables()), so an entry's bucket is never behind the one being
   // taken nor past the window: no clamp. Room for the pushes is made once
   // an expansion, so a push never checks for it.
-  const auto push = [&](int x, int y, std::int64_t f) noexcept -> std::uint32_t {
+  const auto push = [&](std::uint32_t xy, std::int64_t f) noexcept -> std::uint32_t {
     const auto slot = static_cast<std::uint32_t>(static_cast<std::uint64_t>(f - f0) >> shift) & mask;
     std::uint32_t idx = free_list;
     if (idx != kNoEntry) {
@@ -238,41 +236,57 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     } else {
       idx = unused++;
     }
-    pool[idx] = Entry{static_cast<std::uint32_t>(x) | static_cast<std::uint32_t>(y) << 16, head[slot]};
+    pool[idx] = Entry{xy, head[slot]};
     head[slot] = idx;
-    ++live;
     return idx;
   };
-  // The goal is entered like any cell; its cost is the best route so far.
-  const auto relax = [&](std::uint32_t v, int x, int y, std::int64_t g, std::uint32_t step) noexcept {
-    Node& node = nodes[v];
-    if (g >= node.g) return;
-    node.g = g;
-    if (v == goal_index) best = g;
-    node.link = (push(x, y, g + h_of(x, y)) << 3) | step;
+  const auto room_for_8 = [&](std::uint32_t list, std::uint32_t used) noexcept {
+    std::uint32_t room = pool_size - used;
+    for (; list != kNoEntry && room < 8; list = pool[list].next) ++room;
+    return room >= 8;
+  };
+  // A neighbour is its node and its cell packed as an entry holds it (x
+  // in the low 16 bits, y in the high: a step adds a constant to it). The
+  // goal is entered like any cell; its cost is the best route so far.
+  Node* const goal_node = nodes + goal_index;
+  const auto relax = [&](Node* node, std::uint32_t xy, std::int64_t g, std::uint32_t step) noexcept {
+    if (g >= node->g) return;
+    node->g = g;
+    if (node == goal_node) best = g;
+    node->link = (push(xy, g + h_of(static_cast<int>(xy & 0xFFFFu), static_cast<int>(xy >> 16))) << 3) | step;
   };
 
   const std::uint32_t start_index = static_cast<std::uint32_t>(start.y) * row + static_cast<std::uint32_t>(start.x);
   nodes[start_index].g = g0;
-  nodes[start_index].link = push(start.x, start.y, f0) << 3;
+  nodes[start_index].link =
+      push(static_cast<std::uint32_t>(start.x) | static_cast<std::uint32_t>(start.y) << 16, f0) << 3;
   std::size_t expansions = 0;
-  while (live > 0) {
-    const std::uint32_t slot = static_cast<std::uint32_t>(current) & mask;
-    const std::uint32_t idx = head[slot];
-    if (idx == kNoEntry) {  // the bucket is done: stop once the next starts at the goal's cost
-      ++current;
-      if (static_cast<std::int64_t>(current << shift) >= best - f0) break;
-      continue;
+  for (;;) {
+    std::uint32_t slot = static_cast<std::uint32_t>(current) & mask;
+    std::uint32_t idx = head[slot];
+    if (idx == kNoEntry) {  // the bucket is done: on to the next one with entries
+      std::uint32_t empty = 1;
+      do {
+        ++current;
+        // Stop once a bucket starts at the goal's cost, or when a whole
+        // window of buckets is empty: so is the open list.
+        if (static_cast<std::int64_t>(current << shift) >= best - f0 || empty == buckets) break;
+        slot = static_cast<std::uint32_t>(current) & mask;
+        idx = head[slot];
+        ++empty;
+      } while (idx == kNoEntry);
+      if (idx == kNoEntry) break;
     }
     const Entry e = pool[idx];
     head[slot] = e.next;
     pool[idx].next = free_list;
     free_list = idx;
-    --live;
-    const int x = static_cast<int>(e.xy & 0xFFFFu);
-    const int y = static_cast<int>(e.xy >> 16);
+    const std::uint32_t xy = e.xy;
+    const int x = static_cast<int>(xy & 0xFFFFu);
+    const int y = static_cast<int>(xy >> 16);
     const std::uint32_t u = static_cast<std::uint32_t>(y) * row + static_cast<std::uint32_t>(x);
-    Node& node = nodes[u];
+    Node* const np = nodes + u;
+    Node& node = *np;
     if (node.entry() != idx) continue;  // an older entry of a cell improved since
     node.link |= kNoEntry << 3;
     const std::int64_t g = node.g;
@@ -280,11 +294,12 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     // to a cheaper one (the goal's own entry among them: it is never
     // expanded).
     if (best != INT64_MAX && g + h_of(x, y) >= best) continue;
-    if (pool_size - live < 8) {  // room for this expansion's pushes: entries not in a bucket
-      const Compacted left = compact(row, buckets, free_list, live);
+    // Room for this expansion's pushes: the entries never used, and near
+    // the pool's end the free ones too.
+    if (unused + 8 > pool_size && !room_for_8(free_list, unused)) {
+      const Compacted left = compact(row, buckets, free_list);
       free_list = left.free_list;
-      live = left.live;
-      if (pool_size - live < 8) {
+      if (!room_for_8(free_list, unused)) {
         full = true;
         break;
       }
@@ -294,17 +309,17 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     // The orthogonal neighbours' passability (false outside the grid)
     // decides the diagonals too: no step past a blocked corner.
     const bool east = x + 1 < width && passable[c[1]];
-    const bool north = y + 1 < height && passable[c[width]];
+    const bool north = y + 1 < height && passable[c[w]];
     const bool west = x > 0 && passable[c[-1]];
-    const bool south = y > 0 && passable[c[-width]];
-    if (east) relax(u + 1, x + 1, y, g + straight[c[1]], 0);
-    if (north) relax(u + row, x, y + 1, g + straight[c[width]], 1);
-    if (west) relax(u - 1, x - 1, y, g + straight[c[-1]], 2);
-    if (south) relax(u - row, x, y - 1, g + straight[c[-width]], 3);
-    if (east && north && passable[c[width + 1]]) relax(u + row + 1, x + 1, y + 1, g + diagonal[c[width + 1]], 4);
-    if (west && north && passable[c[width - 1]]) relax(u + row - 1, x - 1, y + 1, g + diagonal[c[width - 1]], 5);
-    if (west && south && passable[c[-width - 1]]) relax(u - row - 1, x - 1, y - 1, g + diagonal[c[-width - 1]], 6);
-    if (east && south && passable[c[-width + 1]]) relax(u - row + 1, x + 1, y - 1, g + diagonal[c[-width + 1]], 7);
+    const bool south = y > 0 && passable[c[-w]];
+    if (east) relax(np + 1, xy + 1u, g + straight[c[1]], 0);
+    if (north) relax(np + w, xy + 0x10000u, g + straight[c[w]], 1);
+    if (west) relax(np - 1, xy - 1u, g + straight[c[-1]], 2);
+    if (south) relax(np - w, xy - 0x10000u, g + straight[c[-w]], 3);
+    if (east && north && passable[c[w + 1]]) relax(np + w + 1, xy + 0x10001u, g + diagonal[c[w + 1]], 4);
+    if (west && north && passable[c[w - 1]]) relax(np + w - 1, xy + 0xFFFFu, g + diagonal[c[w - 1]], 5);
+    if (west && south && passable[c[-w - 1]]) relax(np - w - 1, xy - 0x10001u, g + diagonal[c[-w - 1]], 6);
+    if (east && south && passable[c[-w + 1]]) relax(np - w + 1, xy - 0xFFFFu, g + diagonal[c[-w + 1]], 7);
   }
   result.expansions = expansions;
   if (full) result.status = PlanStatus::kOpenListFull;

@@ -139,7 +139,7 @@ class GridPlanner {
   std::int64_t base() const noexcept;
   template <bool kAStar>
   bool search(const CostView& grid, GridCell start, GridCell goal, PlanResult& result) noexcept;
-  Compacted compact(std::uint32_t row, std::uint32_t buckets, std::uint32_t free_list, std::uint32_t live) noexcept;
+  Compacted compact(std::uint32_t row, std::uint32_t buckets, std::uint32_t free_list) noexcept;
 
   int max_width_;
   int max_height_;
