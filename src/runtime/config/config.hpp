@@ -8,6 +8,7 @@
 
 #include "core/fixed_string.hpp"
 #include "estimation/filter_params.hpp"
+#include "estimation/standstill_gyro_bias.hpp"
 #include "geometry/rigid_transform.hpp"
 #include "runtime/config/hardware_config.hpp"
 #include "runtime/config/name.hpp"
@@ -17,6 +18,8 @@ namespace rtfuse {
 constexpr int kMaxSensors = 16;
 // GNSS receivers a robot carries (a dual-antenna set-up at most).
 constexpr int kMaxNavsatSensors = 2;
+// imu sensors with standstill_from (a residual gyro bias learner each).
+constexpr int kMaxStandstillLearners = 4;
 constexpr int kMaxStaticTransforms = 24;
 // Filter instances in one process: robot_localization's dual EKF (a local
 // one in odom, a global one in map) and one more, e.g. to compare tunings.
@@ -44,6 +47,12 @@ struct SensorConfig {
   Name antenna_frame;
   Name heading_imu;
   int heading_sensor = -1;
+  // type "imu": the odometry or twist sensor whose standstills teach the
+  // gyro's residual bias (empty: none), resolved to its index, and the
+  // learner's parameters (estimation/standstill_gyro_bias.hpp).
+  Name standstill_from;
+  int standstill_sensor = -1;
+  est::StandstillBiasParams standstill;
   // The filter instance that fuses it (0: [filter] and the top-level
   // [[sensor]]s; k: the k-th [[instance]] after it).
   int instance = 0;

@@ -324,6 +324,30 @@ void read_navsat(const Section& s, SensorConfig& c) {
   }
 }
 
+constexpr std::string_view kStandstillKeys[] = {"standstill_from", "standstill_block", "standstill_time_constant",
+                                                "standstill_speed", "standstill_yaw_rate"};
+
+// An IMU's residual gyro bias from the wheels' standstills: the wheel
+// sensor is named here and resolved once every sensor is known.
+void read_standstill(const Section& s, SensorConfig& c) {
+  if (s.has("standstill_from")) s.read_name("standstill_from", c.standstill_from);
+  est::StandstillBiasParams& p = c.standstill;
+  read_number(s, "standstill_block", p.block_s, positive_finite, "must be > 0 s and finite");
+  read_number(s, "standstill_time_constant", p.time_constant_s, positive_finite, "must be > 0 s and finite");
+  read_number(s, "standstill_speed", p.still_speed_mps, [](double v) { return v >= 0 && v <= 0.1; },
+              "must be in [0, 0.1] m/s");
+  read_number(s, "standstill_yaw_rate", p.still_yaw_rate, [](double v) { return v >= 0 && v <= 0.1; },
+              "must be in [0, 0.1] rad/s");
+  if (c.standstill_from.empty()) {
+    for (std::string_view k : kStandstillKeys) {
+      if (k != "standstill_from" && s.has(k)) s.key_error(k, "needs standstill_from (the wheel sensor to learn from)");
+    }
+    return;
+  }
+  const char* why = est::validate(p);
+  if (why[0] != '\0') s.value_error("standstill_block", why);
+}
+
 struct SensorEntry {
   SensorConfig cfg;
   bool has_name = false;
@@ -335,7 +359,8 @@ SensorEntry read_sensor(const Section& s) {
                     "pose_rejection_threshold", "twist_rejection_threshold",
                     "linear_acceleration_rejection_threshold", "remove_gravitational_acceleration", "max_rate",
                     "frame", "heading_imu", "use_odometry_yaw", "magnetic_declination_radians", "yaw_offset",
-                    "zero_altitude", "datum", "unknown_covariance", "max_jump", "max_speed"});
+                    "zero_altitude", "datum", "unknown_covariance", "max_jump", "max_speed", "standstill_from",
+                    "standstill_block", "standstill_time_constant", "standstill_speed", "standstill_yaw_rate"});
   s.require({"name", "type"});
   SensorEntry e;
   est::SensorParams& p = e.cfg.params;
@@ -407,6 +432,13 @@ SensorEntry read_sensor(const Section& s) {
       if (s.has(k)) s.key_error(k, "only valid for type 'imu'");
     }
   }
+  if (kind && *kind == est::SensorKind::kImu) {
+    read_standstill(s, e.cfg);
+  } else if (kind) {
+    for (std::string_view k : kStandstillKeys) {
+      if (s.has(k)) s.key_error(k, "only valid for type 'imu' (the gyro whose bias the wheels' standstills teach)");
+    }
+  }
   if (kind && *kind == est::SensorKind::kNavSatFix) {
     read_navsat(s, e.cfg);
   } else if (kind) {
@@ -415,6 +447,33 @@ SensorEntry read_sensor(const Section& s) {
     }
   }
   return e;
+}
+
+// An IMU's standstill_from, by name among its instance's sensors: one whose
+// samples carry the base's twist (odometry, twist).
+void resolve_standstill(const Section& s, const RuntimeConfig& cfg, int first, const std::string& instance_words,
+                        SensorConfig& c) {
+  if (c.standstill_from.empty()) return;
+  for (int j = first; j < cfg.num_sensors; ++j) {
+    const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];
+    if (o.name != c.standstill_from) continue;
+    if (o.params.kind != est::SensorKind::kOdometry && o.params.kind != est::SensorKind::kTwist) {
+      s.value_error("standstill_from", in_quotes(c.standstill_from.view()) + " is a " +
+                                           in_quotes(kind_name(o.params.kind)) +
+                                           " sensor: name the wheels' odometry or twist sensor");
+      return;
+    }
+    int learners = 0;
+    for (int i = 0; i < cfg.num_sensors; ++i) learners += cfg.sensors[static_cast<std::size_t>(i)].standstill_sensor >= 0;
+    if (learners >= kMaxStandstillLearners) {
+      s.key_error("standstill_from", "at most " + std::to_string(kMaxStandstillLearners) +
+                                         " imu sensors with standstill_from in all instances");
+      return;
+    }
+    c.standstill_sensor = j;
+    return;
+  }
+  s.value_error("standstill_from", "no sensor" + instance_words + " is named " + in_quotes(c.standstill_from.view()));
 }
 
 // The [[sensor]] tables of one instance (the top level's for the first, an
@@ -498,6 +557,7 @@ void read_sensors(const Section& parent, RuntimeConfig& cfg, const std::vector<C
     if (t == nullptr) continue;
     const Section s(t, parent.key("sensor") + "[" + std::to_string(i) + "]", parent.diag());
     SensorConfig& c = cfg.sensors[static_cast<std::size_t>(index++)];
+    resolve_standstill(s, cfg, first, instance_words, c);
     if (c.heading_imu.empty()) continue;
     for (int j = first; j < cfg.num_sensors && c.heading_sensor < 0; ++j) {
       const SensorConfig& o = cfg.sensors[static_cast<std::size_t>(j)];

@@ -3,6 +3,8 @@
 #include "runtime/devices/frame_consumer.hpp"
 #include "runtime/devices/grid_consumer.hpp"
 #include "runtime/devices/device_layout.hpp"
+#include "runtime/fusion/navsat_status.hpp"
+#include "runtime/fusion/standstill_status.hpp"
 
 namespace rtfuse {
 namespace {
@@ -23,8 +25,9 @@ std::unique_ptr<Hardware> Hardware::create(const HalBuses& buses, FusionCore& co
   const RuntimeConfig& cfg = core.config();
   std::unique_ptr<Hardware> h(new Hardware());
   const DeviceLayout layout = device_layout(cfg);
-  if (layout.device_slots > kMaxDevices) {
-    *error = "the configuration's devices need " + std::to_string(layout.device_slots) +
+  const int slots = layout.device_slots + navsat_slot_count(cfg) + standstill_slot_count(cfg);
+  if (slots > kMaxDevices) {
+    *error = "the configuration's devices, navsat transforms and gyro bias learners need " + std::to_string(slots) +
              " diagnostics slots, more than the " + std::to_string(kMaxDevices) + " a snapshot holds";
     return nullptr;
   }

@@ -5,6 +5,7 @@
 
 #include "geometry/rotation.hpp"
 #include "runtime/fusion/navsat_status.hpp"
+#include "runtime/fusion/standstill_status.hpp"
 
 namespace rtfuse {
 
@@ -37,6 +38,14 @@ FusionCore::FusionCore(const RuntimeConfig& cfg) : cfg_(cfg) {
     const int k = cfg_.sensors[i].instance < num_instances_ ? cfg_.sensors[i].instance : 0;
     if (absolute_yaw_sources[k] >= 2) models_[i].set_yaw_gate(instance_filter(cfg_, k).yaw_conflict_gate_sigma);
   }
+  for (int i = 0; i < cfg_.num_sensors; ++i) {
+    const SensorConfig& c = cfg_.sensors[i];
+    if (c.standstill_sensor < 0 || c.params.kind != est::SensorKind::kImu) continue;
+    standstill_[i] = std::make_unique<est::StandstillGyroBias>(c.standstill);
+    standstill_targets_[sensor_input(cfg_, c.standstill_sensor)] |= 1u << i;
+    if (num_standstill_ < kMaxStandstillLearners) standstill_sensor_[num_standstill_++] = i;
+  }
+  if (num_standstill_ > 0) describe_standstill(cfg_, standstill_layout_);
   staging_ = std::make_unique<est::SensorSample[]>(static_cast<std::size_t>(staging_capacity_ > 0 ? staging_capacity_ : 1));
 }
 
@@ -150,6 +159,28 @@ void FusionCore::fill_navsat(Snapshot& s) noexcept {
   }
 }
 
+void FusionCore::fill_standstill(Snapshot& s) noexcept {
+  if (num_standstill_ == 0) return;
+  // After the devices' and the navsat transforms' slots.
+  const int first = (devices_ != nullptr ? devices_->slot_count() : 0) + num_navsat_;
+  const int count = first + num_standstill_ <= kMaxDevices ? num_standstill_ : kMaxDevices - first;
+  if (count <= 0) return;  // Hardware::create refuses such a layout; a bare core just has no room
+  if (s.num_devices < first + count) s.num_devices = first + count;
+  for (int k = 0; k < count; ++k) {
+    DeviceStatus& d = s.devices[first + k];
+    d.name = standstill_layout_[k].name;
+    d.hardware_id = standstill_layout_[k].hardware_id;
+    const est::StandstillGyroBias& l = *standstill_[standstill_sensor_[k]];
+    const auto urad = [](double v) { return static_cast<std::int64_t>(std::llround(v * 1e6)); };
+    set_device_values(d, kStandstillKeys,
+                      {l.stats().blocks, l.stats().dropped, l.stats().rejected,
+                       static_cast<std::int64_t>(std::llround(l.learnt_s() * 1e3)), urad(l.bias().x()),
+                       urad(l.bias().y()), urad(l.bias().z())});
+    d.state = l.stats().blocks > 0 ? "learnt" : "waiting for a standstill";
+    d.level = DeviceLevel::kOk;
+  }
+}
+
 void FusionCore::feed_navsat_heading(const est::SensorSample& s) noexcept {
   // navsat_transform_node's imuCallback: the IMU's orientation, its
   // mounting taken off, until the datum is fixed.
@@ -203,10 +234,25 @@ void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
   if (s.kind == est::SensorKind::kImu && s.imu.has_orientation && heading_targets_[s.sensor] != 0) {
     feed_navsat_heading(s);
   }
+  if (standstill_targets_[s.sensor] != 0 &&
+      (s.kind == est::SensorKind::kOdometry || s.kind == est::SensorKind::kTwist)) {
+    for (std::uint32_t m = standstill_targets_[s.sensor]; m != 0; m &= m - 1) {
+      standstill_[__builtin_ctz(m)]->wheels(s.stamp, s.twist.linear.norm(), s.twist.angular.z());
+    }
+  }
   for (std::uint32_t m = fused_by_[s.sensor]; m != 0; m &= m - 1) fuse_into(__builtin_ctz(m), s, now);
 }
 
-void FusionCore::fuse_into(int sensor, const est::SensorSample& s, TimeNs now) noexcept {
+void FusionCore::fuse_into(int sensor, const est::SensorSample& sample, TimeNs now) noexcept {
+  // An IMU whose residual gyro bias the wheels teach: its rates without it.
+  est::SensorSample corrected;
+  const bool correct =
+      standstill_[sensor] != nullptr && sample.kind == est::SensorKind::kImu && sample.imu.has_angular_velocity;
+  if (correct) {
+    corrected = sample;
+    corrected.imu.angular_velocity = standstill_[sensor]->correct(sample.stamp, sample.imu.angular_velocity);
+  }
+  const est::SensorSample& s = correct ? corrected : sample;
   SensorStats& st = stats_[sensor];
   // robot_localization ignores a message older than its topic's previous one.
   if (st.accepted + st.rejected_mahalanobis + st.rejected_stale > 0 && s.stamp < st.last_stamp_ns) {
@@ -371,6 +417,7 @@ void FusionCore::publish_snapshot(TimeNs now, const LoopStats& loop) noexcept {
   s.wheel_odometry.valid = false;
   if (devices_ != nullptr) devices_->fill_snapshot(s);
   fill_navsat(s);
+  fill_standstill(s);
   snapshot_.store(s);
 }
 

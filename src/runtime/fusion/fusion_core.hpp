@@ -7,6 +7,7 @@
 #include "core/seqlock.hpp"
 #include "estimation/filter.hpp"
 #include "estimation/sensor_model.hpp"
+#include "estimation/standstill_gyro_bias.hpp"
 #include "geometry/frame_tree.hpp"
 #include "runtime/config/config.hpp"
 #include "runtime/fusion/input_router.hpp"
@@ -67,6 +68,8 @@ class FusionCore {
   void fill_instance(int k, InstanceSnapshot& out) noexcept;
   // The navsat transforms' slots of the diagnostics.
   void fill_navsat(Snapshot& s) noexcept;
+  // The gyro bias learners' slots, after the navsat transforms'.
+  void fill_standstill(Snapshot& s) noexcept;
 
   // A filter instance: its EKF, the frames it fuses in, and whether it is
   // anchored to the map yet.
@@ -98,6 +101,13 @@ class FusionCore {
   DeviceMessage navsat_message_[kMaxNavsatSensors];
   int navsat_message_key_[kMaxNavsatSensors] = {};  // -1 until formatted (configure_navsat)
   static_assert(kMaxSensors <= 32, "heading_targets_ is a bit set");
+  // Per imu sensor with standstill_from: its residual gyro bias learner;
+  // per input: the sensors whose learner its twist samples teach (bit i).
+  std::unique_ptr<est::StandstillGyroBias> standstill_[kMaxSensors];
+  std::uint32_t standstill_targets_[kMaxSensors] = {};
+  int num_standstill_ = 0;
+  int standstill_sensor_[kMaxStandstillLearners] = {};
+  DeviceStatus standstill_layout_[kMaxStandstillLearners];  // names and ids
   std::unique_ptr<est::SensorSample[]> staging_;
   int staging_capacity_ = 0;
   std::int64_t set_pose_count_ = 0;
