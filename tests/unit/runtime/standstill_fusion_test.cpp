@@ -13,6 +13,7 @@
 #include "rtfuse/odometry_t.hpp"
 #include "runtime/config/config_loader.hpp"
 #include "runtime/fusion/fusion_core.hpp"
+#include "support/alloc_counter.hpp"
 
 namespace rtfuse {
 namespace standstill_fusion_test {
@@ -146,6 +147,30 @@ TEST(StandstillFusion, TheWheelsStandstillTakesTheGyrosResidualBiasOff) {
   for (int i = 0; i < plain.last.num_devices; ++i) {
     EXPECT_NE(std::string(plain.last.devices[i].name.view()), "gyro bias imu0");
   }
+}
+
+TEST(StandstillFusion, LearningAllocatesNothing) {
+  std::string err;
+  auto core = FusionCore::create(load(config(true)), &err);
+  ASSERT_TRUE(core) << err;
+  constexpr TimeNs kT0 = 1'000'000'000, kStep = 20'000'000;
+  std::vector<std::vector<std::uint8_t>> w, g;
+  for (int k = 0; k < 300; ++k) {
+    w.push_back(wheels(kT0 + k * kStep, k < 150 ? 0.0 : 0.5));
+    g.push_back(gyro(kT0 + k * kStep, 0.01));
+  }
+  const auto step = [&](int k) {
+    const TimeNs t = kT0 + k * kStep;
+    core->input().on_message("wheel_odom", w[k].data(), static_cast<int>(w[k].size()), t);
+    core->input().on_message("imu", g[k].data(), static_cast<int>(g[k].size()), t);
+    core->tick(t, LoopStats{});
+  };
+  for (int k = 0; k < 10; ++k) step(k);  // warm up: the first decodes size their strings
+  test::AllocScope scope;
+  for (int k = 10; k < 300; ++k) step(k);
+  EXPECT_EQ(scope.count(), 0u);
+  const Snapshot& s = core->last_snapshot();
+  EXPECT_GE(s.devices[0].values[0], 4);  // blocks learnt, inside the scope
 }
 
 std::string first_error(const std::string& text) {
