@@ -20,6 +20,7 @@
 #include "runtime/fusion/fusion_core.hpp"
 #include "runtime/pipeline/publisher.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/lcm_inputs.hpp"
 
 namespace rtfuse {
 namespace filter_instances_test {
@@ -96,23 +97,8 @@ const est::GeodeticPosition kStart{47.3977, 8.5456, 488.0};
 constexpr TimeNs kT0 = 1'000'000'000;
 constexpr TimeNs kStep = 20'000'000;  // 50 Hz
 
-template <class Msg>
-std::vector<std::uint8_t> encode(const Msg& m) {
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
-
-std::vector<std::uint8_t> wheel(TimeNs t, double vx) {
-  rtfuse::odometry_t m{};
-  m.header.utime = ns_to_utime(t);
-  m.header.frame_id = "odom";
-  m.child_frame_id = "base_link";
-  m.pose.pose.orientation.w = 1.0;
-  for (int i = 0; i < 6; ++i) m.twist.covariance[i * 7] = 1e-4;
-  m.twist.twist.linear.x = vx;
-  return encode(m);
-}
+using test::encode;
+const auto wheel = test::wheel_odometry;
 
 std::vector<std::uint8_t> imu(TimeNs t) {
   rtfuse::imu_t m{};
@@ -168,14 +154,7 @@ class CaptureSink : public MessageSink {
   std::map<std::string, std::vector<std::vector<std::uint8_t>>> messages;
 };
 
-RuntimeConfig load(const std::string& text) {
-  ConfigLoadResult r = load_config_string(text, "test.toml");
-  if (!r.config) {
-    for (const auto& e : r.errors) ADD_FAILURE() << e.to_string();
-    return RuntimeConfig{};
-  }
-  return *r.config;
-}
+const auto load = test::load_config_text;
 
 std::string errors_of(const std::string& text) {
   const ConfigLoadResult r = load_config_string(text, "t.toml");

@@ -14,6 +14,7 @@
 #include "runtime/config/config_loader.hpp"
 #include "runtime/fusion/fusion_core.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/lcm_inputs.hpp"
 
 namespace rtfuse {
 namespace standstill_fusion_test {
@@ -46,31 +47,10 @@ config = [false, false, false, false, false, false,
   return text;
 }
 
-RuntimeConfig load(const std::string& text) {
-  ConfigLoadResult r = load_config_string(text, "test.toml");
-  if (!r.config) {
-    for (const auto& e : r.errors) ADD_FAILURE() << e.to_string();
-  }
-  return *r.config;
-}
+const auto load = test::load_config_text;
 
-template <class Msg>
-std::vector<std::uint8_t> encode(const Msg& m) {
-  std::vector<std::uint8_t> buf(static_cast<std::size_t>(m.getEncodedSize()));
-  m.encode(buf.data(), 0, static_cast<int>(buf.size()));
-  return buf;
-}
-
-std::vector<std::uint8_t> wheels(TimeNs t, double vx) {
-  rtfuse::odometry_t m{};
-  m.header.utime = ns_to_utime(t);
-  m.header.frame_id = "odom";
-  m.child_frame_id = "base_link";
-  m.pose.pose.orientation.w = 1.0;
-  for (int i = 0; i < 6; ++i) m.twist.covariance[i * 7] = 1e-4;
-  m.twist.twist.linear.x = vx;
-  return encode(m);
-}
+using test::encode;
+const auto wheels = test::wheel_odometry;
 
 std::vector<std::uint8_t> gyro(TimeNs t, double yaw_rate) {
   rtfuse::imu_t m{};
