@@ -43,6 +43,7 @@ bool imu_driver_config(const RuntimeConfig& cfg, const geometry::FrameTree& fram
   d.attitude.kp = m.attitude.kp;
   d.attitude.ki = m.attitude.ki;
   d.attitude.gravity = cfg.filter.gravity;
+  d.stillness.enabled = m.attitude.stillness_bias;
   d.noise.gyro_variance = m.gyro_noise_rad_s * m.gyro_noise_rad_s;
   d.noise.accel_variance = m.accel_noise_mps2 * m.accel_noise_mps2;
   d.poll_rate_hz = m.data_ready_chip.empty() ? m.poll_rate_hz : 0.0;

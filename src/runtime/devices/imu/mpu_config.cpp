@@ -9,7 +9,8 @@ namespace rtfuse::config {
 namespace {
 
 void read_attitude(const Section& s, AttitudeSection& a) {
-  s.reject_unknown({"algorithm", "beta", "zeta", "kp", "ki"});
+  s.reject_unknown({"algorithm", "beta", "zeta", "kp", "ki", "stillness_bias"});
+  s.read("stillness_bias", a.stillness_bias);
   std::string alg;
   if (s.read("algorithm", alg)) {
     if (alg == "madgwick") {

@@ -18,6 +18,11 @@ struct AttitudeSection {
   double zeta = 0.005;  // Madgwick gyro-bias gain
   double kp = 1.0;      // Mahony proportional gain
   double ki = 0.02;     // Mahony integral gain (gyro bias)
+  // The driver's gyro bias learner at IMU-only stillness
+  // (drivers/imu/stillness_bias.hpp). Off for a base smooth enough that a
+  // slow steady turn passes its test; the wheels' standstills then teach
+  // the bias instead ([[sensor]] standstill_from).
+  bool stillness_bias = true;
 };
 
 struct MpuSection {
