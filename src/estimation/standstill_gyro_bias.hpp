@@ -26,6 +26,11 @@
 // (a warming part's bias moves; a standstill of minutes should not weigh
 // more than the last few).
 //
+// It trusts the wheels: a wheel sensor that reads zero while the base
+// turns (both counters stuck, a lifted robot spun by hand) teaches that
+// turn. A wheel sensor that falls silent teaches nothing: a full block
+// waits for a confirmation that never comes.
+//
 // Bad input is counted and changes nothing: non-finite rates, speeds or
 // stamps, and wheel samples older than the last one. Fixed-size, no
 // allocation, bounded work per sample; double arithmetic one operation at
