@@ -79,6 +79,17 @@ TEST(StandstillGyroBias, ABlockWaitsForTheWheelsAndAStartDropsIt) {
   EXPECT_NEAR(m.bias().z(), 0.02, 1e-15);
 }
 
+TEST(StandstillGyroBias, SilentWheelsTeachNothing) {
+  // The wheels said "still" twice and then fell silent: the robot may be
+  // driving now. The first full block waits for them for ever.
+  StandstillGyroBias l;
+  l.wheels(0, 0.0, 0.0);
+  l.wheels(50 * kMs, 0.0, 0.0);
+  for (int k = 0; k < 1000; ++k) l.correct(k * 10 * kMs, Eigen::Vector3d(0, 0, 0.02));
+  EXPECT_EQ(l.stats().blocks, 0);
+  EXPECT_EQ(l.bias(), Eigen::Vector3d::Zero());
+}
+
 TEST(StandstillGyroBias, GyroSamplesBeforeTheWheelsStoppedAreNotLearnt) {
   StandstillGyroBias l;
   l.wheels(0, 0.5, 0.0);
