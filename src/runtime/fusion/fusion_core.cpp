@@ -176,7 +176,7 @@ void FusionCore::fill_standstill(Snapshot& s) noexcept {
                       {l.stats().blocks, l.stats().dropped, l.stats().rejected,
                        static_cast<std::int64_t>(std::llround(l.learnt_s() * 1e3)), urad(l.bias().x()),
                        urad(l.bias().y()), urad(l.bias().z())});
-    d.state = l.stats().blocks > 0 ? "learnt" : "waiting for a standstill";
+    d.state = l.stats().blocks > 0 ? "learnt" : "no standstill yet";  // 23 characters at most
     d.level = DeviceLevel::kOk;
   }
 }

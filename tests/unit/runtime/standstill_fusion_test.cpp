@@ -129,6 +129,22 @@ TEST(StandstillFusion, TheWheelsStandstillTakesTheGyrosResidualBiasOff) {
   }
 }
 
+TEST(StandstillFusion, TheSlotSaysSoBeforeTheFirstStandstill) {
+  std::string err;
+  auto core = FusionCore::create(load(config(true)), &err);
+  ASSERT_TRUE(core) << err;
+  constexpr TimeNs t = 1'000'000'000;
+  const auto w = wheels(t, 0.4);
+  core->input().on_message("wheel_odom", w.data(), static_cast<int>(w.size()), t);
+  core->tick(t, LoopStats{});
+  const Snapshot& s = core->last_snapshot();
+  ASSERT_EQ(s.num_devices, 1);
+  EXPECT_STREQ(s.devices[0].name.c_str(), "gyro bias imu0");
+  EXPECT_STREQ(s.devices[0].hardware_id.c_str(), "odom0");
+  EXPECT_STREQ(s.devices[0].state.c_str(), "no standstill yet");
+  EXPECT_EQ(s.devices[0].values[0], 0);
+}
+
 TEST(StandstillFusion, LearningAllocatesNothing) {
   std::string err;
   auto core = FusionCore::create(load(config(true)), &err);
