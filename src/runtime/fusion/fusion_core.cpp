@@ -243,16 +243,19 @@ void FusionCore::fuse(const est::SensorSample& s, TimeNs now) noexcept {
   for (std::uint32_t m = fused_by_[s.sensor]; m != 0; m &= m - 1) fuse_into(__builtin_ctz(m), s, now);
 }
 
-void FusionCore::fuse_into(int sensor, const est::SensorSample& sample, TimeNs now) noexcept {
-  // An IMU whose residual gyro bias the wheels teach: its rates without it.
-  est::SensorSample corrected;
-  const bool correct =
-      standstill_[sensor] != nullptr && sample.kind == est::SensorKind::kImu && sample.imu.has_angular_velocity;
-  if (correct) {
-    corrected = sample;
-    corrected.imu.angular_velocity = standstill_[sensor]->correct(sample.stamp, sample.imu.angular_velocity);
+void FusionCore::fuse_into(int sensor, const est::SensorSample& s, TimeNs now) noexcept {
+  if (standstill_[sensor] != nullptr && s.kind == est::SensorKind::kImu && s.imu.has_angular_velocity) {
+    // An IMU whose residual gyro bias the wheels teach: its rates without
+    // it. Copied only here: every other sample is fused as it came.
+    est::SensorSample corrected = s;
+    corrected.imu.angular_velocity = standstill_[sensor]->correct(s.stamp, s.imu.angular_velocity);
+    fuse_sample(sensor, corrected, now);
+    return;
   }
-  const est::SensorSample& s = correct ? corrected : sample;
+  fuse_sample(sensor, s, now);
+}
+
+void FusionCore::fuse_sample(int sensor, const est::SensorSample& s, TimeNs now) noexcept {
   SensorStats& st = stats_[sensor];
   // robot_localization ignores a message older than its topic's previous one.
   if (st.accepted + st.rejected_mahalanobis + st.rejected_stale > 0 && s.stamp < st.last_stamp_ns) {

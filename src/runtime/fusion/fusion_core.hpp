@@ -64,6 +64,8 @@ class FusionCore {
   // One sample of an input, into every instance that fuses it.
   void fuse(const est::SensorSample& s, TimeNs now) noexcept;
   void fuse_into(int sensor, const est::SensorSample& s, TimeNs now) noexcept;
+  // fuse_into's work, once an IMU's learnt gyro bias is off its rates.
+  void fuse_sample(int sensor, const est::SensorSample& s, TimeNs now) noexcept;
   void publish_snapshot(TimeNs now, const LoopStats& loop) noexcept;
   void fill_instance(int k, InstanceSnapshot& out) noexcept;
   // The navsat transforms' slots of the diagnostics.
