@@ -14,6 +14,7 @@
 #include "runtime/config/config_loader.hpp"
 #include "runtime/fusion/fusion_core.hpp"
 #include "support/alloc_counter.hpp"
+#include "support/device_values.hpp"
 #include "support/lcm_inputs.hpp"
 
 namespace rtfuse {
@@ -109,24 +110,15 @@ TEST(StandstillFusion, TheWheelsStandstillTakesTheGyrosResidualBiasOff) {
   EXPECT_LT(std::fabs(taught.yaw_end - taught.yaw_after_stand), 0.002);
 
   // Its diagnostics slot: blocks learnt, the bias in urad/s.
-  const Snapshot& s = taught.last;
-  int slot = -1;
-  for (int i = 0; i < s.num_devices; ++i) {
-    if (std::string(s.devices[i].name.view()) == "gyro bias imu0") slot = i;
-  }
-  ASSERT_GE(slot, 0);
-  const DeviceStatus& d = s.devices[slot];
-  ASSERT_EQ(d.num_values, 7);
-  EXPECT_STREQ(d.keys[0], "blocks");
-  EXPECT_GE(d.values[0], 4);
-  EXPECT_EQ(d.values[1], 1);  // the block filling when the drive began
-  EXPECT_STREQ(d.keys[6], "bias_z_urad_s");
-  EXPECT_NEAR(static_cast<double>(d.values[6]), 10000.0, 1.0);
-  EXPECT_STREQ(d.state.c_str(), "learnt");
+  const DeviceStatus* d = test::find_device(taught.last, "gyro bias imu0");
+  ASSERT_NE(d, nullptr);
+  ASSERT_EQ(d->num_values, 7);
+  EXPECT_GE(test::device_value(*d, "blocks"), 4);
+  EXPECT_EQ(test::device_value(*d, "dropped"), 1);  // the block filling when the drive began
+  EXPECT_NEAR(static_cast<double>(test::device_value(*d, "bias_z_urad_s")), 10000.0, 1.0);
+  EXPECT_STREQ(d->state.c_str(), "learnt");
   // No slot without the learner.
-  for (int i = 0; i < plain.last.num_devices; ++i) {
-    EXPECT_NE(std::string(plain.last.devices[i].name.view()), "gyro bias imu0");
-  }
+  EXPECT_EQ(test::find_device(plain.last, "gyro bias imu0"), nullptr);
 }
 
 TEST(StandstillFusion, TheSlotSaysSoBeforeTheFirstStandstill) {
@@ -142,7 +134,7 @@ TEST(StandstillFusion, TheSlotSaysSoBeforeTheFirstStandstill) {
   EXPECT_STREQ(s.devices[0].name.c_str(), "gyro bias imu0");
   EXPECT_STREQ(s.devices[0].hardware_id.c_str(), "odom0");
   EXPECT_STREQ(s.devices[0].state.c_str(), "no standstill yet");
-  EXPECT_EQ(s.devices[0].values[0], 0);
+  EXPECT_EQ(test::device_value(s.devices[0], "blocks"), 0);
 }
 
 TEST(StandstillFusion, LearningAllocatesNothing) {
@@ -165,8 +157,9 @@ TEST(StandstillFusion, LearningAllocatesNothing) {
   test::AllocScope scope;
   for (int k = 10; k < 300; ++k) step(k);
   EXPECT_EQ(scope.count(), 0u);
-  const Snapshot& s = core->last_snapshot();
-  EXPECT_GE(s.devices[0].values[0], 4);  // blocks learnt, inside the scope
+  const DeviceStatus* d = test::find_device(core->last_snapshot(), "gyro bias imu0");
+  ASSERT_NE(d, nullptr);
+  EXPECT_GE(test::device_value(*d, "blocks"), 4);  // learnt inside the scope
 }
 
 std::string first_error(const std::string& text) {

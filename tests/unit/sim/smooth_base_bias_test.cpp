@@ -16,8 +16,9 @@
 #include "runtime/replay/hal_recording.hpp"
 #include "runtime/replay/hal_replay.hpp"
 #include "sim/sim_drive.hpp"
-#include "transport/event_log.hpp"
+#include "support/device_values.hpp"
 #include "support/sim_toml.hpp"
+#include "transport/event_log.hpp"
 
 namespace rtfuse::sim {
 namespace smooth_base_bias_test {
@@ -71,15 +72,10 @@ TEST(SmoothBaseBias, TheWheelsStandstillsTeachTheGyroBiasWhereTheImuAloneCannot)
   // The learner's slot: blocks from the three standstills, the bias it
   // took off (the scenario's -0.2 deg/s on z, in urad/s, within what its
   // averaging leaves).
-  const Snapshot& s = wheels.final;
-  int slot = -1;
-  for (int i = 0; i < s.num_devices; ++i) {
-    if (std::string(s.devices[i].name.view()) == "gyro bias imu") slot = i;
-  }
-  ASSERT_GE(slot, 0);
-  const DeviceStatus& d = s.devices[slot];
-  EXPECT_GE(d.values[0], 10) << "blocks";
-  EXPECT_NEAR(static_cast<double>(d.values[6]), -3491.0, 300.0) << "bias_z_urad_s";
+  const DeviceStatus* d = test::find_device(wheels.final, "gyro bias imu");
+  ASSERT_NE(d, nullptr);
+  EXPECT_GE(test::device_value(*d, "blocks"), 10);
+  EXPECT_NEAR(static_cast<double>(test::device_value(*d, "bias_z_urad_s")), -3491.0, 300.0);
 }
 
 TEST(SmoothBaseBias, TheLearningReplaysBitForBit) {
@@ -110,10 +106,13 @@ TEST(SmoothBaseBias, TheLearningReplaysBitForBit) {
   EXPECT_EQ(std::memcmp(r.final.state, drive.final.state, sizeof r.final.state), 0);
   // The learner's slot, every counter and the bias, as recorded.
   ASSERT_EQ(r.final.num_devices, drive.final.num_devices);
-  const int slot = r.final.num_devices - 1;
-  EXPECT_STREQ(r.final.devices[slot].name.c_str(), "gyro bias imu");
-  for (int k = 0; k < r.final.devices[slot].num_values; ++k) {
-    EXPECT_EQ(r.final.devices[slot].values[k], drive.final.devices[slot].values[k]) << r.final.devices[slot].keys[k];
+  const DeviceStatus* replayed = test::find_device(r.final, "gyro bias imu");
+  const DeviceStatus* recorded = test::find_device(drive.final, "gyro bias imu");
+  ASSERT_NE(replayed, nullptr);
+  ASSERT_NE(recorded, nullptr);
+  EXPECT_GT(test::device_value(*recorded, "blocks"), 0);
+  for (int k = 0; k < recorded->num_values; ++k) {
+    EXPECT_EQ(replayed->values[k], recorded->values[k]) << recorded->keys[k];
   }
 }
 
