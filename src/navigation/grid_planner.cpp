@@ -15,12 +15,17 @@ constexpr std::uint32_t kNoEntry = 0x1FFFFFFFu;
 constexpr std::uint32_t kMaxBuckets = 8192;
 constexpr int kFractionBits = 32;
 constexpr int kBucketBits = 4;  // buckets 1/16 of a cell wide
-// Every f of a search stays below 2^55 (so no sum overflows), and a plan's
-// costs are kept offset by (kPlansPerEpoch - plan) * 2^56 (Node).
+// Every f of a search stays below 2^55, so it fits a node's word shifted
+// past its four flag bits, and a plan's costs are kept offset by
+// (kPlansPerEpoch - plan) * 2^59 (Node).
 constexpr double kFixedPointLimit = 3.6e16;
-constexpr int kEpochShift = 56;
-constexpr std::uint32_t kPlansPerEpoch = 127;
-constexpr std::int64_t kNeverReached = INT64_MAX;
+constexpr int kFlagBits = 4;
+constexpr std::uint64_t kStepBits = 7;
+constexpr std::uint64_t kExpanded = 8;
+constexpr std::uint64_t kFlags = 15;
+constexpr int kEpochShift = 59;
+constexpr std::uint32_t kPlansPerEpoch = 31;
+constexpr std::uint64_t kNeverReached = UINT64_MAX;
 
 // The 8 steps: the four orthogonal first (E, N, W, S), then the diagonals
 // (NE, NW, SW, SE), each between two of them.
@@ -33,19 +38,19 @@ bool inside(const CostView& grid, GridCell c) noexcept {
 
 }  // namespace
 
-// A cell's state: its cost from the start (fixed point) offset by the
-// plan's epoch base, its newest open-list entry (kNoEntry when it has none
-// waiting) and the step that reached it, in one word. The base falls by
-// 2^56 from one plan to the next while every cost stays below 2^55, so a
-// cell last reached in an earlier plan holds more than any cost of this
-// one: "not reached yet" and "reached at a higher cost" are one compare,
-// and nothing is cleared between plans but once every 127 plans.
+// A cell's state in one word: its cost from the start (fixed point)
+// shifted past four flags and offset by the plan's epoch base, whether it
+// has been expanded at that cost, and the step that reached it. The base
+// falls by 2^59 from one plan to the next while every shifted cost stays
+// below 2^59, so a cell last reached in an earlier plan holds more than
+// any cost of this one: "not reached yet" and "reached at a higher cost"
+// are one compare, and nothing is cleared between plans but once every 31
+// plans. Eight bytes a cell: an expansion's three rows of neighbours touch
+// half the cache lines sixteen did.
 struct GridPlanner::Node {
-  std::int64_t g;
-  std::uint32_t link;  // entry << 3 | step
+  std::uint64_t v;  // base + (g << 4) | expanded << 3 | step
 
-  std::uint32_t entry() const noexcept { return link >> 3; }
-  std::uint32_t step() const noexcept { return link & 7u; }
+  std::uint32_t step() const noexcept { return static_cast<std::uint32_t>(v & kStepBits); }
 };
 
 // An open-list entry: the cell (x in the low 16 bits, y in the high) and
@@ -77,7 +82,7 @@ GridPlanner::GridPlanner(int max_width, int max_height, std::size_t max_path_cel
                                 " entries: at most 2^29 - 2");
   }
   nodes_.reset(new Node[cells_]);
-  for (std::size_t i = 0; i < cells_; ++i) nodes_[i] = Node{kNeverReached, kNoEntry << 3};
+  for (std::size_t i = 0; i < cells_; ++i) nodes_[i] = Node{kNeverReached};
   pool_.reset(new Entry[pool_size_]);
   head_.reset(new std::uint32_t[kMaxBuckets]);
   path_.reset(new GridCell[max_path_]);
@@ -121,13 +126,13 @@ void GridPlanner::make_tables(const PlannerParams& params, std::size_t cells) no
 
 void GridPlanner::next_plan() noexcept {
   if (++plan_ > kPlansPerEpoch) {  // the bases are used up: forget every cost
-    for (std::size_t i = 0; i < cells_; ++i) nodes_[i].g = kNeverReached;
+    for (std::size_t i = 0; i < cells_; ++i) nodes_[i].v = kNeverReached;
     plan_ = 1;
   }
 }
 
-std::int64_t GridPlanner::base() const noexcept {
-  return static_cast<std::int64_t>(kPlansPerEpoch - plan_) << kEpochShift;
+std::uint64_t GridPlanner::base() const noexcept {
+  return static_cast<std::uint64_t>(kPlansPerEpoch - plan_) << kEpochShift;
 }
 
 // What compact() leaves: the free entries' list.
@@ -135,24 +140,30 @@ struct GridPlanner::Compacted {
   std::uint32_t free_list;
 };
 
-// Drops the entries no cell points to any more (older entries of cells
-// improved since, and cells already expanded) from the buckets to the
-// free list. At most one entry per cell is left, so a pool 8 larger than
-// the grid always gains room for an expansion; a smaller one may not, and
-// the search then ends (kOpenListFull). Takes and returns values, so that
-// the search's counters stay in registers (their addresses never taken).
-GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t buckets,
+// Drops the entries the search no longer needs (those of cells expanded
+// at their cost, and all but the first of a cell's others) from the
+// buckets to the free list. Buckets are walked from the one being taken
+// and each from its newest entry, so the entry kept is the cell's
+// cheapest: the one the search would take. The expanded flag marks a cell
+// whose entry is kept during the walk, and is cleared again after it. At
+// most one entry per cell is left, so a pool 8 larger than the grid
+// always gains room for an expansion; a smaller one may not, and the
+// search then ends (kOpenListFull). Takes and returns values, so that the
+// search's counters stay in registers (their addresses never taken).
+GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t buckets, std::uint32_t first,
                                             std::uint32_t free_list) noexcept {
   ++compactions_;
   Entry* const pool = pool_.get();
-  const Node* const nodes = nodes_.get();
-  for (std::uint32_t b = 0; b < buckets; ++b) {
-    std::uint32_t* link = &head_[b];
+  Node* const nodes = nodes_.get();
+  const auto node_of = [&](const Entry& e) -> Node& { return nodes[(e.xy >> 16) * row + (e.xy & 0xFFFFu)]; };
+  for (std::uint32_t k = 0; k < buckets; ++k) {
+    std::uint32_t* link = &head_[(first + k) & (buckets - 1)];
     while (*link != kNoEntry) {
       const std::uint32_t idx = *link;
       Entry& e = pool[idx];
-      const Node& n = nodes[(e.xy >> 16) * row + (e.xy & 0xFFFFu)];
-      if (n.entry() == idx) {
+      Node& n = node_of(e);
+      if ((n.v & kExpanded) == 0) {
+        n.v |= kExpanded;
         link = &e.next;
       } else {
         *link = e.next;
@@ -160,6 +171,9 @@ GridPlanner::Compacted GridPlanner::compact(std::uint32_t row, std::uint32_t buc
         free_list = idx;
       }
     }
+  }
+  for (std::uint32_t b = 0; b < buckets; ++b) {
+    for (std::uint32_t idx = head_[b]; idx != kNoEntry; idx = pool[idx].next) node_of(pool[idx]).v &= ~kExpanded;
   }
   return Compacted{free_list};
 }
@@ -181,28 +195,29 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   const std::uint32_t goal_index = static_cast<std::uint32_t>(gy) * row + static_cast<std::uint32_t>(gx);
   // The octile distance in the fixed point: hi - lo straight steps and lo
   // diagonal ones of factor 1, each the same integer a step's cost is.
-  const std::int64_t unit = straight_[kCostFree];
-  const std::int64_t diagonal_unit = diagonal_[kCostFree];
-  const auto h_of = [=](int x, int y) noexcept -> std::int64_t {
+  const std::uint64_t unit = static_cast<std::uint64_t>(straight_[kCostFree]) << kFlagBits;
+  const std::uint64_t diagonal_unit = static_cast<std::uint64_t>(diagonal_[kCostFree]) << kFlagBits;
+  const auto h_of = [=](int x, int y) noexcept -> std::uint64_t {
     if constexpr (kAStar) {
       const int dx = std::abs(x - gx);
       const int dy = std::abs(y - gy);
       const int lo = dx < dy ? dx : dy;
       const int hi = dx < dy ? dy : dx;
-      return static_cast<std::int64_t>(hi - lo) * unit + static_cast<std::int64_t>(lo) * diagonal_unit;
+      return static_cast<std::uint64_t>(hi - lo) * unit + static_cast<std::uint64_t>(lo) * diagonal_unit;
     } else {
       static_cast<void>(x);
       static_cast<void>(y);
       return 0;
     }
   };
+  // The steps' costs shifted as a node holds them.
   bool passable[256];
-  std::int64_t straight[256];
-  std::int64_t diagonal[256];
+  std::uint64_t straight[256];
+  std::uint64_t diagonal[256];
   for (int c = 0; c < 256; ++c) {
     passable[c] = passable_[c];
-    straight[c] = straight_[c];
-    diagonal[c] = diagonal_[c];
+    straight[c] = static_cast<std::uint64_t>(straight_[c]) << kFlagBits;
+    diagonal[c] = static_cast<std::uint64_t>(diagonal_[c]) << kFlagBits;
   }
   Node* const nodes = nodes_.get();
   Entry* const pool = pool_.get();
@@ -210,9 +225,9 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   const auto pool_size = static_cast<std::uint32_t>(pool_size_);
   const std::uint32_t buckets = buckets_;
   const std::uint32_t mask = buckets - 1;
-  const int shift = bucket_shift_;
-  const std::int64_t g0 = base();                      // costs are kept offset by it
-  const std::int64_t f0 = g0 + h_of(start.x, start.y);  // bucket 0 begins at the start's f
+  const int shift = bucket_shift_ + kFlagBits;
+  const std::uint64_t g0 = base();                      // costs are kept offset by it
+  const std::uint64_t f0 = g0 + h_of(start.x, start.y);  // bucket 0 begins at the start's f
   for (std::uint32_t k = 0; k < buckets; ++k) head[k] = kNoEntry;
   std::uint64_t current = 0;  // the bucket being taken, counted from bucket 0 (not modulo)
   std::uint32_t free_list = kNoEntry;
@@ -221,15 +236,15 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   // The goal's cost so far: an upper bound. Buckets starting at or above it
   // and entries whose f reaches it cannot lead to a cheaper route: the
   // former are not taken, the latter not expanded.
-  std::int64_t best = INT64_MAX;
+  std::uint64_t best = UINT64_MAX;
 
   // f never falls along a step (the costs and the heuristic are consistent
   // exactly, in integers) and rises by at most two of the largest steps
   // (make_tables()), so an entry's bucket is never behind the one being
   // taken nor past the window: no clamp. Room for the pushes is made once
   // an expansion, so a push never checks for it.
-  const auto push = [&](std::uint32_t xy, std::int64_t f) noexcept -> std::uint32_t {
-    const auto slot = static_cast<std::uint32_t>(static_cast<std::uint64_t>(f - f0) >> shift) & mask;
+  const auto push = [&](std::uint32_t xy, std::uint64_t f) noexcept {
+    const auto slot = static_cast<std::uint32_t>((f - f0) >> shift) & mask;
     std::uint32_t idx = free_list;
     if (idx != kNoEntry) {
       free_list = pool[idx].next;
@@ -238,7 +253,6 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     }
     pool[idx] = Entry{xy, head[slot]};
     head[slot] = idx;
-    return idx;
   };
   const auto room_for_8 = [&](std::uint32_t list, std::uint32_t used) noexcept {
     std::uint32_t room = pool_size - used;
@@ -249,17 +263,16 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   // in the low 16 bits, y in the high: a step adds a constant to it). The
   // goal is entered like any cell; its cost is the best route so far.
   Node* const goal_node = nodes + goal_index;
-  const auto relax = [&](Node* node, std::uint32_t xy, std::int64_t g, std::uint32_t step) noexcept {
-    if (g >= node->g) return;
-    node->g = g;
+  const auto relax = [&](Node* node, std::uint32_t xy, std::uint64_t g, std::uint64_t step) noexcept {
+    if ((g | kFlags) >= node->v) return;
+    node->v = g | step;
     if (node == goal_node) best = g;
-    node->link = (push(xy, g + h_of(static_cast<int>(xy & 0xFFFFu), static_cast<int>(xy >> 16))) << 3) | step;
+    push(xy, g + h_of(static_cast<int>(xy & 0xFFFFu), static_cast<int>(xy >> 16)));
   };
 
   const std::uint32_t start_index = static_cast<std::uint32_t>(start.y) * row + static_cast<std::uint32_t>(start.x);
-  nodes[start_index].g = g0;
-  nodes[start_index].link =
-      push(static_cast<std::uint32_t>(start.x) | static_cast<std::uint32_t>(start.y) << 16, f0) << 3;
+  nodes[start_index].v = g0;
+  push(static_cast<std::uint32_t>(start.x) | static_cast<std::uint32_t>(start.y) << 16, f0);
   std::size_t expansions = 0;
   for (;;) {
     std::uint32_t slot = static_cast<std::uint32_t>(current) & mask;
@@ -270,7 +283,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
         ++current;
         // Stop once a bucket starts at the goal's cost, or when a whole
         // window of buckets is empty: so is the open list.
-        if (static_cast<std::int64_t>(current << shift) >= best - f0 || empty == buckets) break;
+        if ((current << shift) >= best - f0 || empty == buckets) break;
         slot = static_cast<std::uint32_t>(current) & mask;
         idx = head[slot];
         ++empty;
@@ -287,17 +300,21 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     const std::uint32_t u = static_cast<std::uint32_t>(y) * row + static_cast<std::uint32_t>(x);
     Node* const np = nodes + u;
     Node& node = *np;
-    if (node.entry() != idx) continue;  // an older entry of a cell improved since
-    node.link |= kNoEntry << 3;
-    const std::int64_t g = node.g;
+    // A cell already expanded at its cost: this is an older entry of it
+    // (its newest, cheaper, is taken first: a lower bucket, or later in
+    // the same one).
+    const std::uint64_t v = node.v;
+    if (v & kExpanded) continue;
+    node.v = v | kExpanded;
+    const std::uint64_t g = v & ~kFlags;
     // Once the goal has a route, an entry at or above its cost cannot lead
     // to a cheaper one (the goal's own entry among them: it is never
     // expanded).
-    if (best != INT64_MAX && g + h_of(x, y) >= best) continue;
+    if (best != UINT64_MAX && g + h_of(x, y) >= best) continue;
     // Room for this expansion's pushes: the entries never used, and near
     // the pool's end the free ones too.
     if (unused + 8 > pool_size && !room_for_8(free_list, unused)) {
-      const Compacted left = compact(row, buckets, free_list);
+      const Compacted left = compact(row, buckets, static_cast<std::uint32_t>(current) & mask, free_list);
       free_list = left.free_list;
       if (!room_for_8(free_list, unused)) {
         full = true;
@@ -323,7 +340,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   }
   result.expansions = expansions;
   if (full) result.status = PlanStatus::kOpenListFull;
-  return !full && best < INT64_MAX;
+  return !full && best < UINT64_MAX;
 }
 
 PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal,
@@ -379,8 +396,9 @@ PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal
     }
     if (cells > max_path_) {
       result.status = PlanStatus::kPathTooLong;
-      const std::int64_t g =
-          nodes_[static_cast<std::size_t>(goal.y) * row + static_cast<std::size_t>(goal.x)].g - base();
+      const auto g = static_cast<std::int64_t>(
+          ((nodes_[static_cast<std::size_t>(goal.y) * row + static_cast<std::size_t>(goal.x)].v & ~kFlags) - base()) >>
+          kFlagBits);
       result.cost = std::ldexp(static_cast<double>(g), -fraction_bits_);
       return result;
     }

@@ -47,7 +47,7 @@
 // allocates nothing and never throws. A search keeps no state between
 // plans: each plan's costs are offset by a base that falls from one plan
 // to the next, so a cell's cost from an earlier plan reads as "not reached
-// yet" and nothing the size of the grid is cleared but once every 127
+// yet" and nothing the size of the grid is cleared but once every 31
 // plans.
 #include <cstddef>
 #include <cstdint>
@@ -136,21 +136,21 @@ class GridPlanner {
 
   void make_tables(const PlannerParams& params, std::size_t cells) noexcept;
   void next_plan() noexcept;
-  std::int64_t base() const noexcept;
+  std::uint64_t base() const noexcept;
   template <bool kAStar>
   bool search(const CostView& grid, GridCell start, GridCell goal, PlanResult& result) noexcept;
-  Compacted compact(std::uint32_t row, std::uint32_t buckets, std::uint32_t free_list) noexcept;
+  Compacted compact(std::uint32_t row, std::uint32_t buckets, std::uint32_t first, std::uint32_t free_list) noexcept;
 
   int max_width_;
   int max_height_;
   std::size_t max_path_;
   std::size_t cells_;
   std::size_t pool_size_;
-  std::unique_ptr<Node[]> nodes_;           // per cell: g (offset by the plan's base), its newest entry and step
+  std::unique_ptr<Node[]> nodes_;           // per cell: g (offset by the plan's base), expanded, step
   std::unique_ptr<Entry[]> pool_;           // the open list's entries, linked in buckets
   std::unique_ptr<std::uint32_t[]> head_;   // per bucket: its newest entry
   std::unique_ptr<GridCell[]> path_;
-  std::uint32_t plan_ = 0;  // 1..127 in an epoch of plans (Node)
+  std::uint32_t plan_ = 0;  // 1..31 in an epoch of plans (Node)
   std::size_t compactions_ = 0;
   // Per plan: by cell cost, passable or not, the factor, the straight and
   // diagonal steps in fixed point; the fixed point's fraction bits and the
