@@ -233,10 +233,14 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   std::uint32_t free_list = kNoEntry;
   std::uint32_t unused = 0;  // entries never used yet start here
   bool full = false;         // an open list smaller than the grid held only needed entries
-  // The goal's cost so far: an upper bound. Buckets starting at or above it
-  // and entries whose f reaches it cannot lead to a cheaper route: the
-  // former are not taken, the latter not expanded.
-  std::uint64_t best = UINT64_MAX;
+  // The goal's node holds its cost so far, an upper bound: buckets
+  // starting at or above it and entries whose f reaches it cannot lead to
+  // a cheaper route, the former are not taken, the latter not expanded.
+  // Read where it decides, never tracked: a relaxation only writes nodes.
+  // Until the goal is reached in this plan its node holds more than any f
+  // (kNeverReached or an earlier plan's cost).
+  Node* const goal_node = nodes + goal_index;
+  const std::uint64_t this_plan = g0 + (std::uint64_t{1} << kEpochShift);  // every node of this plan is below
 
   // f never falls along a step (the costs and the heuristic are consistent
   // exactly, in integers) and rises by at most two of the largest steps
@@ -261,12 +265,10 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   };
   // A neighbour is its node and its cell packed as an entry holds it (x
   // in the low 16 bits, y in the high: a step adds a constant to it). The
-  // goal is entered like any cell; its cost is the best route so far.
-  Node* const goal_node = nodes + goal_index;
+  // goal is entered like any cell.
   const auto relax = [&](Node* node, std::uint32_t xy, std::uint64_t g, std::uint64_t step) noexcept {
     if ((g | kFlags) >= node->v) return;
     node->v = g | step;
-    if (node == goal_node) best = g;
     push(xy, g + h_of(static_cast<int>(xy & 0xFFFFu), static_cast<int>(xy >> 16)));
   };
 
@@ -283,7 +285,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
         ++current;
         // Stop once a bucket starts at the goal's cost, or when a whole
         // window of buckets is empty: so is the open list.
-        if ((current << shift) >= best - f0 || empty == buckets) break;
+        if ((current << shift) >= (goal_node->v & ~kFlags) - f0 || empty == buckets) break;
         slot = static_cast<std::uint32_t>(current) & mask;
         idx = head[slot];
         ++empty;
@@ -310,7 +312,8 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     // Once the goal has a route, an entry at or above its cost cannot lead
     // to a cheaper one (the goal's own entry among them: it is never
     // expanded).
-    if (best != UINT64_MAX && g + h_of(x, y) >= best) continue;
+    const std::uint64_t goal_v = goal_node->v;
+    if (goal_v < this_plan && (g + h_of(x, y)) >= (goal_v & ~kFlags)) continue;
     // Room for this expansion's pushes: the entries never used, and near
     // the pool's end the free ones too.
     if (unused + 8 > pool_size && !room_for_8(free_list, unused)) {
@@ -340,7 +343,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   }
   result.expansions = expansions;
   if (full) result.status = PlanStatus::kOpenListFull;
-  return !full && best < UINT64_MAX;
+  return !full && goal_node->v < this_plan;
 }
 
 PlanResult GridPlanner::plan(const CostView& grid, GridCell start, GridCell goal,
