@@ -193,20 +193,22 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   const auto row = static_cast<std::uint32_t>(width);
   const std::ptrdiff_t w = width;  // a row's stride, in cells and in nodes
   const std::uint32_t goal_index = static_cast<std::uint32_t>(gy) * row + static_cast<std::uint32_t>(gx);
-  // The octile distance in the fixed point: hi - lo straight steps and lo
-  // diagonal ones of factor 1, each the same integer a step's cost is.
+  // The octile distance in the fixed point, from a cell's offset to the
+  // goal: hi - lo straight steps and lo diagonal ones of factor 1, each the
+  // same integer a step's cost is (hi times the one, lo times the other's
+  // excess over it: the same sum).
   const std::uint64_t unit = static_cast<std::uint64_t>(straight_[kCostFree]) << kFlagBits;
-  const std::uint64_t diagonal_unit = static_cast<std::uint64_t>(diagonal_[kCostFree]) << kFlagBits;
-  const auto h_of = [=](int x, int y) noexcept -> std::uint64_t {
+  const std::uint64_t diagonal_excess = (static_cast<std::uint64_t>(diagonal_[kCostFree]) << kFlagBits) - unit;
+  const auto h_of = [=](int dx, int dy) noexcept -> std::uint64_t {
     if constexpr (kAStar) {
-      const int dx = std::abs(x - gx);
-      const int dy = std::abs(y - gy);
+      dx = std::abs(dx);
+      dy = std::abs(dy);
       const int lo = dx < dy ? dx : dy;
       const int hi = dx < dy ? dy : dx;
-      return static_cast<std::uint64_t>(hi - lo) * unit + static_cast<std::uint64_t>(lo) * diagonal_unit;
+      return static_cast<std::uint64_t>(hi) * unit + static_cast<std::uint64_t>(lo) * diagonal_excess;
     } else {
-      static_cast<void>(x);
-      static_cast<void>(y);
+      static_cast<void>(dx);
+      static_cast<void>(dy);
       return 0;
     }
   };
@@ -227,7 +229,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   const std::uint32_t mask = buckets - 1;
   const int shift = bucket_shift_ + kFlagBits;
   const std::uint64_t g0 = base();                      // costs are kept offset by it
-  const std::uint64_t f0 = g0 + h_of(start.x, start.y);  // bucket 0 begins at the start's f
+  const std::uint64_t f0 = g0 + h_of(start.x - gx, start.y - gy);  // bucket 0 begins at the start's f
   for (std::uint32_t k = 0; k < buckets; ++k) head[k] = kNoEntry;
   std::uint64_t current = 0;  // the bucket being taken, counted from bucket 0 (not modulo)
   std::uint32_t free_list = kNoEntry;
@@ -266,10 +268,12 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
   // A neighbour is its node and its cell packed as an entry holds it (x
   // in the low 16 bits, y in the high: a step adds a constant to it). The
   // goal is entered like any cell.
-  const auto relax = [&](Node* node, std::uint32_t xy, std::uint64_t g, std::uint64_t step) noexcept {
+  // dx, dy: the neighbour's offset to the goal, for its heuristic.
+  const auto relax = [&](Node* node, std::uint32_t xy, std::uint64_t g, std::uint64_t step, int dx,
+                         int dy) noexcept {
     if ((g | kFlags) >= node->v) return;
     node->v = g | step;
-    push(xy, g + h_of(static_cast<int>(xy & 0xFFFFu), static_cast<int>(xy >> 16)));
+    push(xy, g + h_of(dx, dy));
   };
 
   const std::uint32_t start_index = static_cast<std::uint32_t>(start.y) * row + static_cast<std::uint32_t>(start.x);
@@ -313,7 +317,7 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     // to a cheaper one (the goal's own entry among them: it is never
     // expanded).
     const std::uint64_t goal_v = goal_node->v;
-    if (goal_v < this_plan && (g + h_of(x, y)) >= (goal_v & ~kFlags)) continue;
+    if (goal_v < this_plan && (g + h_of(x - gx, y - gy)) >= (goal_v & ~kFlags)) continue;
     // Room for this expansion's pushes: the entries never used, and near
     // the pool's end the free ones too.
     if (unused + 8 > pool_size && !room_for_8(free_list, unused)) {
@@ -332,14 +336,24 @@ bool GridPlanner::search(const CostView& grid, GridCell start, GridCell goal, Pl
     const bool north = y + 1 < height && passable[c[w]];
     const bool west = x > 0 && passable[c[-1]];
     const bool south = y > 0 && passable[c[-w]];
-    if (east) relax(np + 1, xy + 1u, g + straight[c[1]], 0);
-    if (north) relax(np + w, xy + 0x10000u, g + straight[c[w]], 1);
-    if (west) relax(np - 1, xy - 1u, g + straight[c[-1]], 2);
-    if (south) relax(np - w, xy - 0x10000u, g + straight[c[-w]], 3);
-    if (east && north && passable[c[w + 1]]) relax(np + w + 1, xy + 0x10001u, g + diagonal[c[w + 1]], 4);
-    if (west && north && passable[c[w - 1]]) relax(np + w - 1, xy + 0xFFFFu, g + diagonal[c[w - 1]], 5);
-    if (west && south && passable[c[-w - 1]]) relax(np - w - 1, xy - 0x10001u, g + diagonal[c[-w - 1]], 6);
-    if (east && south && passable[c[-w + 1]]) relax(np - w + 1, xy - 0xFFFFu, g + diagonal[c[-w + 1]], 7);
+    const int dx = x - gx;
+    const int dy = y - gy;
+    if (east) relax(np + 1, xy + 1u, g + straight[c[1]], 0, dx + 1, dy);
+    if (north) relax(np + w, xy + 0x10000u, g + straight[c[w]], 1, dx, dy + 1);
+    if (west) relax(np - 1, xy - 1u, g + straight[c[-1]], 2, dx - 1, dy);
+    if (south) relax(np - w, xy - 0x10000u, g + straight[c[-w]], 3, dx, dy - 1);
+    if (east && north && passable[c[w + 1]]) {
+      relax(np + w + 1, xy + 0x10001u, g + diagonal[c[w + 1]], 4, dx + 1, dy + 1);
+    }
+    if (west && north && passable[c[w - 1]]) {
+      relax(np + w - 1, xy + 0xFFFFu, g + diagonal[c[w - 1]], 5, dx - 1, dy + 1);
+    }
+    if (west && south && passable[c[-w - 1]]) {
+      relax(np - w - 1, xy - 0x10001u, g + diagonal[c[-w - 1]], 6, dx - 1, dy - 1);
+    }
+    if (east && south && passable[c[-w + 1]]) {
+      relax(np - w + 1, xy - 0xFFFFu, g + diagonal[c[-w + 1]], 7, dx + 1, dy - 1);
+    }
   }
   result.expansions = expansions;
   if (full) result.status = PlanStatus::kOpenListFull;
