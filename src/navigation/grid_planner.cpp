@@ -104,7 +104,8 @@ void GridPlanner::make_tables(const PlannerParams& params, std::size_t cells) no
     if (passable_[c] && factor_[c] > most) most = factor_[c];
   }
   // A route visits each cell once at most, h is at most the grid's
-  // octile diameter: f < 2 sqrt(2) most cells in cells, kept under 2^62.
+  // octile diameter: f < 2 sqrt(2) most cells in cells, kept under 2^55
+  // (a node holds it shifted past its four flags, under 2^59).
   int bits = kFractionBits;
   while (bits > 0 && std::ldexp(2.0 * kSqrt2 * most * static_cast<double>(cells + 2), bits) > kFixedPointLimit) --bits;
   fraction_bits_ = bits;

@@ -414,6 +414,42 @@ TEST(GridPlanner, AFullOpenListDropsDeadEntriesAndPlansTheSame) {
   EXPECT_GT(ran_out, 5u);
 }
 
+TEST(GridPlanner, CostsOutliveThePlanBasesAndATooLongPathStillSaysItsCost) {
+  // Many plans in a row cross the per-plan cost base's resets (every 31
+  // plans); a goal never reached keeps an earlier plan's cost in its cell,
+  // which must read as "not reached", never as a route. A path longer than
+  // the buffer is refused with the search's cost, the optimum's.
+  Grid g = filled(60, 40, 0);
+  for (int dx = -1; dx <= 1; ++dx) {
+    for (int dy = -1; dy <= 1; ++dy) {
+      if (dx != 0 || dy != 0) g.at(30 + dx, 20 + dy) = 254;
+    }
+  }
+  const GridCell walled_in{30, 20};
+  Random r(31);
+  GridPlanner roomy(60, 40, 60 * 40);
+  GridPlanner short_buffer(60, 40, 12);
+  int too_long = 0;
+  for (int k = 0; k < 200; ++k) {
+    PlannerParams p = params(0.25 * r.below(12), r.chance(50) ? SearchMode::kAStar : SearchMode::kDijkstra);
+    const GridCell s = random_cell(r, g), e = random_cell(r, g);
+    if (g.at(s.x, s.y) != 0 || g.at(e.x, e.y) != 0 || s == walled_in || e == walled_in) continue;
+    EXPECT_EQ(roomy.plan(g.view(), s, walled_in, p).status, PlanStatus::kNoRoute) << "plan " << k;
+    const PlanResult a = roomy.plan(g.view(), s, e, p);
+    ASSERT_TRUE(a.ok()) << "plan " << k;
+    const PlanResult b = short_buffer.plan(g.view(), s, e, p);
+    if (a.path_cells <= 12) {
+      EXPECT_TRUE(b.ok()) << "plan " << k;
+      continue;
+    }
+    ++too_long;
+    EXPECT_EQ(b.status, PlanStatus::kPathTooLong) << "plan " << k;
+    EXPECT_NEAR(b.cost, a.cost, 1e-9 * a.cost) << "plan " << k;
+    EXPECT_EQ(b.path_cells, 0u);
+  }
+  EXPECT_GT(too_long, 100);
+}
+
 TEST(GridPlanner, TheCostWeightZeroIsThePlainGraph) {
   // A grid of costs with weight 0 plans as its free/lethal picture with any
   // weight: steps of 1 and sqrt 2.
