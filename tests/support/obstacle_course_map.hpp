@@ -36,8 +36,10 @@ class ObstacleCourseMapping {
   static constexpr double kResolution = 0.05;
   static constexpr double kRange = 6.0;
 
-  ObstacleCourseMapping()
-      : map_(occupancy_params(), mapping::capacity_for_bytes(std::size_t{256} << 20)),
+  // occupancy_threshold: OctoMap's (0.5) unless a config sets another, as
+  // config/sim_nav.toml does.
+  explicit ObstacleCourseMapping(double occupancy_threshold = 0.5)
+      : map_(occupancy_params(occupancy_threshold), mapping::capacity_for_bytes(std::size_t{256} << 20)),
         matcher_(kWidth, kHeight, disparity_params()),
         texture_(kWidth, kHeight) {
     if (!sim::load_drive_scenario(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacles.toml", &scenario_,
@@ -63,9 +65,10 @@ class ObstacleCourseMapping {
   const std::string& error() const { return error_; }
   const sim::CameraWorld& world() const { return *world_; }
   const mapping::OccupancyMap& map() const { return map_; }
-  static mapping::OccupancyParams occupancy_params() {
+  static mapping::OccupancyParams occupancy_params(double occupancy_threshold = 0.5) {
     mapping::OccupancyParams mp;
     mp.resolution = kResolution;
+    mp.occupancy_threshold = occupancy_threshold;
     return mp;
   }
   static vision::DisparityParams disparity_params() {

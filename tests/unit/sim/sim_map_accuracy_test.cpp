@@ -20,6 +20,12 @@
 // "Map accuracy in simulation"). The bounds below are today's figures with
 // a margin: they catch a regression (a geometry slip put 93 % of the
 // occupied cells in free space), not the goal.
+//
+// Scored twice: with OctoMap's occupancy threshold (0.5: one hit occupies)
+// and a keyframe every 2 s, and as config/sim_nav.toml maps, a keyframe
+// every 0.2 s (the mapper's 5 a second) and a voxel occupied at 0.8 (two
+// hits more than its misses' worth): a surface seen from frame to frame
+// stays, a stray match seldom repeats.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -39,8 +45,19 @@ using namespace rtfuse;
 
 using test::ObstacleCourseMapping;
 
-TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
-  ObstacleCourseMapping course;
+struct Score {
+  int cells_seen = 0;
+  double seen_recall = 0.0;   // the first target's share
+  double recall = 0.0;        // of every solid cell the map knows
+  double recall_near = 0.0;   // the same, an occupied cell within one
+  double false_share = 0.0;   // the second target's share
+  double far_share = 0.0;     // occupied more than a cell from any solid
+};
+
+// Maps the course with a keyframe every every_s seconds and scores the
+// grid between 0.1 and 2 m against the world.
+void score_course(double every_s, double occupancy_threshold, Score* out) {
+  ObstacleCourseMapping course(occupancy_threshold);
   ASSERT_EQ(course.error(), "");
   const sim::CameraWorld& world = course.world();
   const mapping::OccupancyMap& map = course.map();
@@ -50,7 +67,7 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
   // The world points the camera truly saw through each matched pixel,
   // within the range (the "seen" of the first target).
   std::vector<Eigen::Vector3d> seen_points;
-  const int frames = course.drive(2.0, [&](const geometry::RigidTransform& world_T_camera) {
+  const int frames = course.drive(every_s, [&](const geometry::RigidTransform& world_T_camera) {
     for (int v = 0; v < course.disparity_height(); ++v) {
       for (int u = 0; u < course.disparity_width(); ++u) {
         const double pu = downscale * u + 0.5 * (downscale - 1), pv = downscale * v + 0.5 * (downscale - 1);
@@ -112,7 +129,6 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
   const double seen_recall = static_cast<double>(seen_occupied) / cells_seen;
   std::printf("%d obstacle cells the camera saw: %.1f %% occupied (the issue: at least 95 %%)\n", cells_seen,
               100.0 * seen_recall);
-  EXPECT_GE(seen_recall, 0.95);
 
   // Strictly, and within a cell: a face on a cell line leaves its fringe of
   // hits one cell out, and a face cell seen past at a slant is carved free.
@@ -149,12 +165,29 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
               frames, static_cast<unsigned long long>(map.known_voxels()),
               static_cast<unsigned long long>(map.occupied_voxels()), solid_seen, 100.0 * recall,
               100.0 * recall_near, occupied, 100.0 * false_share, 100.0 * far_share);
+  *out = Score{cells_seen, seen_recall, recall, recall_near, false_share, far_share};
+}
+
+TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
+  Score s;
+  ASSERT_NO_FATAL_FAILURE(score_course(2.0, 0.5, &s));
+  EXPECT_GE(s.seen_recall, 0.95);
   // Today (4 paths): 66 % (87 % within a cell) and 61 % (50 %) over every
   // known solid cell; the issue asks at most 2 % free.
-  EXPECT_GE(recall, 0.60);
-  EXPECT_GE(recall_near, 0.84);
-  EXPECT_LE(false_share, 0.68);
-  EXPECT_LE(far_share, 0.56);
+  EXPECT_GE(s.recall, 0.60);
+  EXPECT_GE(s.recall_near, 0.84);
+  EXPECT_LE(s.false_share, 0.68);
+  EXPECT_LE(s.far_share, 0.56);
+}
+
+TEST(SimMapAccuracy, AsTheNavigationConfigMapsIt) {
+  Score s;
+  ASSERT_NO_FATAL_FAILURE(score_course(0.2, 0.8, &s));
+  EXPECT_GE(s.seen_recall, 0.95);
+  // Today: 35 % free in truth (18 % more than a cell from a solid), against
+  // 56 % (47 %) with one hit at the same rate; the issue asks at most 2 %.
+  EXPECT_LE(s.false_share, 0.40);
+  EXPECT_LE(s.far_share, 0.22);
 }
 
 }  // namespace sim_map_accuracy_test
