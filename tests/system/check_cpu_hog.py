@@ -21,9 +21,11 @@ Checks (each can fail): the starved loop reports overruns while the hog runs,
 and the report arrives before the hog ends; from 1 s after it ends the
 overrun rate is under a quarter of the hog's (the rest of a busy machine may
 still cost some); the protected loop has at most a twentieth of the starved
-one's overruns during the hog, and at least half its reports (20 Hz) arrive
-during it; every estimate is finite. Figures are printed for
-docs/reliability.md.
+one's overruns during the hog or one a second of it, whichever is more (on
+a fast VM the starved loop misses only some 70 ticks in 5 s, and the
+hypervisor alone costs a protected one a few), and at least half its
+reports (20 Hz) arrive during it; every estimate is finite. Figures are
+printed for docs/reliability.md.
 """
 
 import math
@@ -183,9 +185,12 @@ def main():
                  " so this run shows nothing")
         elif starved["detect_ms"] is None or starved["detect_ms"] > starved["hog_s"] * 1e3:
             fail("SCHED_OTHER: the overruns were not reported while the hog ran")
-    if starved and protected and starved["overruns"] >= 10 and protected["overruns"] * 20 > starved["overruns"]:
-        fail(f"SCHED_FIFO: {protected['overruns']} overruns under the hog, more than a twentieth of "
-             f"SCHED_OTHER's {starved['overruns']}: the real-time priority did not protect the loop")
+    if starved and protected and starved["overruns"] >= 10:
+        allowed = max(starved["overruns"] / 20.0, protected["hog_s"])
+        if protected["overruns"] > allowed:
+            fail(f"SCHED_FIFO: {protected['overruns']} overruns under the hog, more than a twentieth of "
+                 f"SCHED_OTHER's {starved['overruns']} and more than one a second of its {protected['hog_s']:.1f} s:"
+                 " the real-time priority did not protect the loop")
     # Reports as lcm-logger (not prioritised, on the busy rest of the
     # machine in CI) received them: counted, not timed.
     if protected and protected["reports_during"] < 0.5 * 20 * protected["hog_s"]:
