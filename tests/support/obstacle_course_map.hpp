@@ -36,10 +36,11 @@ class ObstacleCourseMapping {
   static constexpr double kResolution = 0.05;
   static constexpr double kRange = 6.0;
 
-  // occupancy_threshold: OctoMap's (0.5) unless a config sets another, as
-  // config/sim_nav.toml does.
-  explicit ObstacleCourseMapping(double occupancy_threshold = 0.5)
-      : map_(occupancy_params(occupancy_threshold), mapping::capacity_for_bytes(std::size_t{256} << 20)),
+  // occupancy_threshold and range: OctoMap's 0.5 and the mapper's default
+  // 6 m unless a config sets others, as config/sim_nav.toml does.
+  explicit ObstacleCourseMapping(double occupancy_threshold = 0.5, double range = kRange)
+      : range_(range),
+        map_(occupancy_params(occupancy_threshold), mapping::capacity_for_bytes(std::size_t{256} << 20)),
         matcher_(kWidth, kHeight, disparity_params()),
         texture_(kWidth, kHeight) {
     if (!sim::load_drive_scenario(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacles.toml", &scenario_,
@@ -65,6 +66,7 @@ class ObstacleCourseMapping {
   const std::string& error() const { return error_; }
   const sim::CameraWorld& world() const { return *world_; }
   const mapping::OccupancyMap& map() const { return map_; }
+  double range() const { return range_; }
   static mapping::OccupancyParams occupancy_params(double occupancy_threshold = 0.5) {
     mapping::OccupancyParams mp;
     mp.resolution = kResolution;
@@ -133,7 +135,7 @@ class ObstacleCourseMapping {
           vision::view_of(disparity), downscale, camera, world_T_camera, points.data(), points.size());
       const Eigen::Vector3d& o = world_T_camera.translation;
       map_.insert_scan(points.data(), c.points,
-                       {static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z())}, kRange);
+                       {static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z())}, range_);
     }
     return frames;
   }
@@ -143,6 +145,7 @@ class ObstacleCourseMapping {
   sim::PathPlan plan_;
   std::unique_ptr<sim::CameraWorld> world_;
   std::unique_ptr<sim::StereoRenderer> renderer_;
+  double range_;
   mapping::OccupancyMap map_;
   vision::SemiGlobalMatcher matcher_;
   vision::TextureFilter texture_;

@@ -21,11 +21,12 @@
 // a margin: they catch a regression (a geometry slip put 93 % of the
 // occupied cells in free space), not the goal.
 //
-// Scored twice: with OctoMap's occupancy threshold (0.5: one hit occupies)
-// and a keyframe every 2 s, and as config/sim_nav.toml maps, a keyframe
-// every 0.2 s (the mapper's 5 a second) and a voxel occupied at 0.8 (two
-// hits more than its misses' worth): a surface seen from frame to frame
-// stays, a stray match seldom repeats.
+// Scored twice: with OctoMap's occupancy threshold (0.5: one hit occupies),
+// the mapper's default 6 m range and a keyframe every 2 s; and as
+// config/sim_nav.toml maps, a keyframe every 0.2 s (the mapper's 5 a
+// second), a 4 m range and a voxel occupied at 0.8 (two hits more than its
+// misses' worth): a surface seen from frame to frame stays, a stray match
+// seldom repeats. "Seen" is within each one's range.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -56,8 +57,8 @@ struct Score {
 
 // Maps the course with a keyframe every every_s seconds and scores the
 // grid between 0.1 and 2 m against the world.
-void score_course(double every_s, double occupancy_threshold, Score* out) {
-  ObstacleCourseMapping course(occupancy_threshold);
+void score_course(double every_s, double occupancy_threshold, double range, Score* out) {
+  ObstacleCourseMapping course(occupancy_threshold, range);
   ASSERT_EQ(course.error(), "");
   const sim::CameraWorld& world = course.world();
   const mapping::OccupancyMap& map = course.map();
@@ -73,7 +74,7 @@ void score_course(double every_s, double occupancy_threshold, Score* out) {
         const double pu = downscale * u + 0.5 * (downscale - 1), pv = downscale * v + 0.5 * (downscale - 1);
         const double z = test::true_depth(world, world_T_camera, kF, kCx, kCy, pu, pv);
         const Eigen::Vector3d in_camera((pu - kCx) * z / kF, (pv - kCy) * z / kF, z);
-        if (std::isfinite(z) && in_camera.norm() <= ObstacleCourseMapping::kRange) {
+        if (std::isfinite(z) && in_camera.norm() <= course.range()) {
           seen_points.push_back(world_T_camera * in_camera);
         }
       }
@@ -170,7 +171,7 @@ void score_course(double every_s, double occupancy_threshold, Score* out) {
 
 TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
   Score s;
-  ASSERT_NO_FATAL_FAILURE(score_course(2.0, 0.5, &s));
+  ASSERT_NO_FATAL_FAILURE(score_course(2.0, 0.5, ObstacleCourseMapping::kRange, &s));
   EXPECT_GE(s.seen_recall, 0.95);
   // Today (4 paths): 66 % (87 % within a cell) and 61 % (50 %) over every
   // known solid cell; the issue asks at most 2 % free.
@@ -182,11 +183,14 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
 
 TEST(SimMapAccuracy, AsTheNavigationConfigMapsIt) {
   Score s;
-  ASSERT_NO_FATAL_FAILURE(score_course(0.2, 0.8, &s));
-  EXPECT_GE(s.seen_recall, 0.95);
-  // Today: 35 % free in truth (18 % more than a cell from a solid), against
-  // 56 % (47 %) with one hit at the same rate; the issue asks at most 2 %.
-  EXPECT_LE(s.false_share, 0.40);
+  ASSERT_NO_FATAL_FAILURE(score_course(0.2, 0.8, 4.0, &s));
+  // Today: 92 % of the seen obstacle cells occupied (99 % with one hit at
+  // the same rate and range: two hits cost some of what is seen only
+  // briefly; the issue's 95 % holds at the defaults above), and 39 % of
+  // the occupied cells free in truth, 18 % more than a cell from a solid
+  // (47 % and 33 % with one hit); the issue asks at most 2 %.
+  EXPECT_GE(s.seen_recall, 0.90);
+  EXPECT_LE(s.false_share, 0.44);
   EXPECT_LE(s.far_share, 0.22);
 }
 
