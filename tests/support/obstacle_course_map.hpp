@@ -5,9 +5,12 @@
 // resolution, 64 disparities: the live default), textureless pixels
 // dropped, turned into points and inserted at 0.05 m with a 6 m range.
 // True poses: what the map shows is the depth's and the map's doing, not
-// the filter's. The map accuracy test scores it against the world's truth;
+// the filter's. CourseMappingSettings can put the world's origin off the
+// map's voxel lines and replace the matcher's disparities with the truth.
+// The map accuracy test scores it against the world's truth;
 // the planner's reference test and benchmark plan on its costmap, a map
 // from a simulated drive (issue 28).
+#include <cmath>
 #include <cstdint>
 #include <memory>
 #include <random>
@@ -24,10 +27,28 @@
 #include "sim/stereo_renderer.hpp"
 #include "support/pinhole_stereo.hpp"
 #include "support/synthetic_costmap.hpp"
+#include "support/world_depth.hpp"
 #include "vision/semi_global_matcher.hpp"
 #include "vision/texture_filter.hpp"
 
 namespace rtfuse::test {
+
+// How the course is mapped: OctoMap's occupancy threshold and the mapper's
+// default 6 m range unless a config sets others, as config/sim_nav.toml
+// does.
+struct CourseMappingSettings {
+  double occupancy_threshold = 0.5;
+  double range = 6.0;
+  // Where the world's origin lies in the map's frame. Zero puts the
+  // course's faces on voxel boundaries, where a point on a face belongs to
+  // the voxel on its positive side: outside every face that looks toward
+  // +x or +y. A robot's map starts where it does, not on the walls' lines.
+  Eigen::Vector3d map_offset = Eigen::Vector3d::Zero();
+  // The renderer's true disparity (in the matcher's fixed point) at every
+  // pixel the matcher estimated, in place of its estimate: the map with
+  // the stereo's error taken out.
+  bool true_disparity = false;
+};
 
 class ObstacleCourseMapping {
  public:
@@ -36,11 +57,9 @@ class ObstacleCourseMapping {
   static constexpr double kResolution = 0.05;
   static constexpr double kRange = 6.0;
 
-  // occupancy_threshold and range: OctoMap's 0.5 and the mapper's default
-  // 6 m unless a config sets others, as config/sim_nav.toml does.
-  explicit ObstacleCourseMapping(double occupancy_threshold = 0.5, double range = kRange)
-      : range_(range),
-        map_(occupancy_params(occupancy_threshold), mapping::capacity_for_bytes(std::size_t{256} << 20)),
+  explicit ObstacleCourseMapping(const CourseMappingSettings& settings = CourseMappingSettings())
+      : settings_(settings),
+        map_(occupancy_params(settings.occupancy_threshold), mapping::capacity_for_bytes(std::size_t{256} << 20)),
         matcher_(kWidth, kHeight, disparity_params()),
         texture_(kWidth, kHeight) {
     if (!sim::load_drive_scenario(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacles.toml", &scenario_,
@@ -66,7 +85,8 @@ class ObstacleCourseMapping {
   const std::string& error() const { return error_; }
   const sim::CameraWorld& world() const { return *world_; }
   const mapping::OccupancyMap& map() const { return map_; }
-  double range() const { return range_; }
+  double range() const { return settings_.range; }
+  const Eigen::Vector3d& map_offset() const { return settings_.map_offset; }
   static mapping::OccupancyParams occupancy_params(double occupancy_threshold = 0.5) {
     mapping::OccupancyParams mp;
     mp.resolution = kResolution;
@@ -94,9 +114,9 @@ class ObstacleCourseMapping {
   }
 
   // Maps a pair every every_s seconds of the lap, from its start to its
-  // end; on_frame(world_T_camera) sees each camera pose before its pair is
-  // inserted. The keyframes mapped, or -1 when a pair could not be
-  // rendered or matched (error() says which).
+  // end; on_frame(world_T_camera) sees each camera pose (in the world's
+  // frame) before its pair is inserted. The keyframes mapped, or -1 when a
+  // pair could not be rendered or matched (error() says which).
   template <typename OnFrame>
   int drive(double every_s, OnFrame&& on_frame) {
     if (!error_.empty()) return -1;
@@ -131,21 +151,39 @@ class ObstacleCourseMapping {
       }
       const int downscale = disparity_params().downscale;
       texture_.apply(vision::view_of(left), downscale, vision::view_of(disparity));
+      if (settings_.true_disparity) replace_with_truth(world_T_camera, &disparity);
+      geometry::RigidTransform map_T_camera = world_T_camera;
+      map_T_camera.translation += settings_.map_offset;
       const mapping::DisparityPointCounts c = mapping::disparity_points(
-          vision::view_of(disparity), downscale, camera, world_T_camera, points.data(), points.size());
-      const Eigen::Vector3d& o = world_T_camera.translation;
+          vision::view_of(disparity), downscale, camera, map_T_camera, points.data(), points.size());
+      const Eigen::Vector3d& o = map_T_camera.translation;
       map_.insert_scan(points.data(), c.points,
-                       {static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z())}, range_);
+                       {static_cast<float>(o.x()), static_cast<float>(o.y()), static_cast<float>(o.z())},
+                       settings_.range);
     }
     return frames;
   }
 
  private:
+  void replace_with_truth(const geometry::RigidTransform& world_T_camera, vision::Plane<std::uint16_t>* disparity) {
+    const int downscale = disparity_params().downscale;
+    for (int v = 0; v < disparity->height(); ++v) {
+      for (int u = 0; u < disparity->width(); ++u) {
+        std::uint16_t& d = disparity->row(v)[u];
+        if (d == vision::kInvalidDisparity) continue;
+        const double z = true_depth(*world_, world_T_camera, kF, kCx, kCy, downscale * u + 0.5 * (downscale - 1),
+                                    downscale * v + 0.5 * (downscale - 1));
+        const double raw = std::isfinite(z) ? std::round(kF * kBaseline * vision::kDisparityScale / z) : 0.0;
+        d = raw < vision::kInvalidDisparity ? static_cast<std::uint16_t>(raw) : vision::kInvalidDisparity;
+      }
+    }
+  }
+
+  CourseMappingSettings settings_;
   sim::DriveScenario scenario_;
   sim::PathPlan plan_;
   std::unique_ptr<sim::CameraWorld> world_;
   std::unique_ptr<sim::StereoRenderer> renderer_;
-  double range_;
   mapping::OccupancyMap map_;
   vision::SemiGlobalMatcher matcher_;
   vision::TextureFilter texture_;

@@ -5,11 +5,16 @@
 // pixels dropped, turned into points with the camera's true pose and
 // inserted at 0.05 m with a 6 m range, then the 2-D grid between 0.1 and
 // 2 m. True poses: this scores the depth and the map, not the filter.
+// The map's frame lies half a cell off the world's, as a robot's map has
+// no reason to start on its walls' lines; on them, a point on a face that
+// looks toward +x or +y belongs to the voxel outside it, and the renderer's
+// true depth put 32 % of the occupied cells in free space.
 //
 // The issue's first target, "at least 95 % of the true obstacle cells the
 // camera saw are occupied", is scored as it reads: the cells of the drive
-// area where a surface the camera truly saw lies (each matched pixel's ray
-// cast against the world, within the range and the grid's heights). It is
+// area where a surface the camera truly saw lies (each pixel's ray, at the
+// disparity's resolution, cast against the world, within the range and the
+// grid's heights). It is
 // met. Scored instead over every solid cell whose column the map knows, it
 // is not, and cannot be: a box's inside is known from the rays over its
 // top and never seen.
@@ -26,7 +31,10 @@
 // config/sim_nav.toml maps, a keyframe every 0.2 s (the mapper's 5 a
 // second), a 4 m range and a voxel occupied at 0.8 (two hits more than its
 // misses' worth): a surface seen from frame to frame stays, a stray match
-// seldom repeats. "Seen" is within each one's range.
+// seldom repeats. "Seen" is within each one's range. And a third time with
+// the renderer's true disparity in place of the matcher's: both targets
+// hold, so the scoring and the path from disparity to grid are right, and
+// the matcher's depth is what misses the second.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -44,6 +52,7 @@ namespace sim_map_accuracy_test {
 
 using namespace rtfuse;
 
+using test::CourseMappingSettings;
 using test::ObstacleCourseMapping;
 
 struct Score {
@@ -55,11 +64,23 @@ struct Score {
   double far_share = 0.0;     // occupied more than a cell from any solid
 };
 
+// The map's frame half a cell off the world's: every face of the course
+// then runs through the middle of a cell (CourseMappingSettings says why).
+CourseMappingSettings settings(double occupancy_threshold, double range) {
+  CourseMappingSettings s;
+  s.occupancy_threshold = occupancy_threshold;
+  s.range = range;
+  const double half_cell = 0.5 * ObstacleCourseMapping::kResolution;
+  s.map_offset = Eigen::Vector3d(half_cell, half_cell, 0.0);
+  return s;
+}
+
 // Maps the course with a keyframe every every_s seconds and scores the
 // grid between 0.1 and 2 m against the world.
-void score_course(double every_s, double occupancy_threshold, double range, Score* out) {
-  ObstacleCourseMapping course(occupancy_threshold, range);
+void score_course(double every_s, const CourseMappingSettings& settings, Score* out) {
+  ObstacleCourseMapping course(settings);
   ASSERT_EQ(course.error(), "");
+  const Eigen::Vector3d& offset = course.map_offset();
   const sim::CameraWorld& world = course.world();
   const mapping::OccupancyMap& map = course.map();
   constexpr double kF = ObstacleCourseMapping::kF, kCx = ObstacleCourseMapping::kCx, kCy = ObstacleCourseMapping::kCy;
@@ -75,7 +96,7 @@ void score_course(double every_s, double occupancy_threshold, double range, Scor
         const double z = test::true_depth(world, world_T_camera, kF, kCx, kCy, pu, pv);
         const Eigen::Vector3d in_camera((pu - kCx) * z / kF, (pv - kCy) * z / kF, z);
         if (std::isfinite(z) && in_camera.norm() <= course.range()) {
-          seen_points.push_back(world_T_camera * in_camera);
+          seen_points.push_back(world_T_camera * in_camera);  // the world's frame
         }
       }
     }
@@ -83,18 +104,21 @@ void score_course(double every_s, double occupancy_threshold, double range, Scor
   ASSERT_GT(frames, 0) << course.error();
   EXPECT_EQ(map.dropped_updates(), 0u);
 
-  // The drive area only: its obstacles stand on the grid's lines, so a cell
-  // is wholly solid or wholly free (the boxes beyond it stand askew).
+  // The drive area only (the boxes beyond it stand askew); a cell is solid
+  // when a solid overlaps it, so the cell a face runs through is.
   const sim::CameraWorldConfig& area = world.config();
   mapping::GridSpec spec;
   spec.z_min = 0.1;  // above the floor's voxels
   spec.z_max = 2.0;
-  ASSERT_TRUE(map.grid().key_of(area.min_x, spec.first_x) && map.grid().key_of(area.min_y, spec.first_y));
+  ASSERT_TRUE(map.grid().key_of(area.min_x + offset.x(), spec.first_x) &&
+              map.grid().key_of(area.min_y + offset.y(), spec.first_y));
   spec.width = static_cast<int>((area.max_x - area.min_x) / kResolution);
   spec.height = static_cast<int>((area.max_y - area.min_y) / kResolution);
   std::vector<std::int8_t> cells(spec.cells());
   mapping::project_to_grid(map, spec, cells.data());
-  const double x0 = mapping::grid_origin_x(map.grid(), spec), y0 = mapping::grid_origin_y(map.grid(), spec);
+  // The grid's corner in the world's frame.
+  const double x0 = mapping::grid_origin_x(map.grid(), spec) - offset.x();
+  const double y0 = mapping::grid_origin_y(map.grid(), spec) - offset.y();
   const auto cell_at = [&](int i, int j) {
     if (i < 0 || j < 0 || i >= spec.width || j >= spec.height) return mapping::kCellUnknown;
     return cells[static_cast<std::size_t>(j) * static_cast<std::size_t>(spec.width) + static_cast<std::size_t>(i)];
@@ -131,8 +155,7 @@ void score_course(double every_s, double occupancy_threshold, double range, Scor
   std::printf("%d obstacle cells the camera saw: %.1f %% occupied (the issue: at least 95 %%)\n", cells_seen,
               100.0 * seen_recall);
 
-  // Strictly, and within a cell: a face on a cell line leaves its fringe of
-  // hits one cell out, and a face cell seen past at a slant is carved free.
+  // Strictly, and within a cell.
   int solid_seen = 0, solid_occupied = 0, solid_occupied_near = 0, occupied = 0, occupied_free = 0,
       occupied_far = 0;
   for (int j = 0; j < spec.height; ++j) {
@@ -171,10 +194,12 @@ void score_course(double every_s, double occupancy_threshold, double range, Scor
 
 TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
   Score s;
-  ASSERT_NO_FATAL_FAILURE(score_course(2.0, 0.5, ObstacleCourseMapping::kRange, &s));
+  ASSERT_NO_FATAL_FAILURE(score_course(2.0, settings(0.5, ObstacleCourseMapping::kRange), &s));
   EXPECT_GE(s.seen_recall, 0.95);
-  // Today (4 paths): 66 % (87 % within a cell) and 61 % (50 %) over every
-  // known solid cell; the issue asks at most 2 % free.
+  // Today (4 paths): 97 % of the seen cells occupied; 64 % (85 % within a
+  // cell) of every known solid cell, and 62 % of the occupied cells free
+  // in truth (50 % more than a cell from a solid); the issue asks at most
+  // 2 % free.
   EXPECT_GE(s.recall, 0.60);
   EXPECT_GE(s.recall_near, 0.84);
   EXPECT_LE(s.false_share, 0.68);
@@ -183,15 +208,27 @@ TEST(SimMapAccuracy, ObstacleCourseAgainstTheWorldsTruth) {
 
 TEST(SimMapAccuracy, AsTheNavigationConfigMapsIt) {
   Score s;
-  ASSERT_NO_FATAL_FAILURE(score_course(0.2, 0.8, 4.0, &s));
-  // Today: 92 % of the seen obstacle cells occupied (99 % with one hit at
-  // the same rate and range: two hits cost some of what is seen only
-  // briefly; the issue's 95 % holds at the defaults above), and 39 % of
-  // the occupied cells free in truth, 18 % more than a cell from a solid
-  // (47 % and 33 % with one hit); the issue asks at most 2 %.
+  ASSERT_NO_FATAL_FAILURE(score_course(0.2, settings(0.8, 4.0), &s));
+  // Today: 94.6 % of the seen obstacle cells occupied (two hits cost some
+  // of what is seen only briefly; the issue's 95 % holds at the defaults
+  // above), and 39 % of the occupied cells free in truth, 16 % more than
+  // a cell from a solid; the issue asks at most 2 %.
   EXPECT_GE(s.seen_recall, 0.90);
   EXPECT_LE(s.false_share, 0.44);
   EXPECT_LE(s.far_share, 0.22);
+}
+
+TEST(SimMapAccuracy, TheTrueDisparityMeetsBothTargets) {
+  CourseMappingSettings truth = settings(0.5, ObstacleCourseMapping::kRange);
+  truth.true_disparity = true;
+  Score s;
+  ASSERT_NO_FATAL_FAILURE(score_course(2.0, truth, &s));
+  // Today: 97.7 % and 0.0 % (the seen cells the matcher left no pixel
+  // of, or saw only at a slant that later rays carved, stay unknown or
+  // free). The pipeline from disparity to grid meets the issue's targets:
+  // what misses the second is the matcher's depth.
+  EXPECT_GE(s.seen_recall, 0.95);
+  EXPECT_LE(s.false_share, 0.02);
 }
 
 }  // namespace sim_map_accuracy_test
