@@ -4,7 +4,7 @@
 // stamp, preprocess and fuse, then publish a snapshot through the seqlock.
 #include <memory>
 
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "estimation/filter.hpp"
 #include "estimation/sensor_model.hpp"
 #include "estimation/standstill_gyro_bias.hpp"

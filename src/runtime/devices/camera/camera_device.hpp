@@ -3,7 +3,7 @@
 // rectifies it into the frame pool, then lends the newest pair to every
 // attached frame consumer (the visual odometry, a mapper; frame_consumer.hpp)
 // by handle, never by copy. Its health crosses to the loop through a
-// seqlock; its preview and camera info go out on the publisher thread.
+// SeqLatch; its preview and camera info go out on the publisher thread.
 //
 // With a consumer attached at creation, a step also takes the frames the
 // device has already captured (the driver's catch-up): when a consumer falls
@@ -16,7 +16,7 @@
 #include <string>
 
 #include "core/frame_pool.hpp"
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "drivers/camera/stereo_camera.hpp"
 #include "runtime/devices/camera/camera_outputs.hpp"
 #include "runtime/devices/frame_consumer.hpp"
@@ -90,7 +90,7 @@ class CameraDevice final : public Device, public FrameSource {
   FrameConsumer* fed_ = nullptr;       // the first consumer feeding a sensor
   std::uint64_t last_lent_ = 0;        // the newest frame id handed to the consumers
   Health scratch_;
-  SeqLock<Health> health_;
+  SeqLatch<Health> health_;
   std::atomic<std::int64_t> frames_{0};
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 };

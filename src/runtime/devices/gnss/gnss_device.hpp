@@ -2,14 +2,14 @@
 // A GNSS receiver as a thread device: each step waits on the serial port for
 // bytes, turns complete epochs into navsat samples for the sensor with
 // source = "gnss" (stamped at their epoch: the receive time less the
-// configured latency), and reports the receiver's health through a seqlock.
+// configured latency), and reports the receiver's health through a SeqLatch.
 // A port that went away (a USB receiver unplugged) is reopened with a
 // backoff, as the camera is.
 #include <atomic>
 #include <memory>
 #include <string>
 
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "drivers/gnss/gnss_receiver.hpp"
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/device_buses.hpp"
@@ -71,7 +71,7 @@ class GnssDevice final : public Device {
   drivers::GnssFix fixes_[kFixesPerStep];
   est::SensorSample sample_;
   Health scratch_;
-  SeqLock<Health> health_;
+  SeqLatch<Health> health_;
   std::atomic<std::int64_t> samples_{0};
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 };

@@ -1,12 +1,12 @@
 #pragma once
 // The MPU IMU as a thread device: each step waits for one data-ready edge (or
 // the next poll), reads the chip, filters attitude and pushes one sample into
-// the IMU sensor's ring; its health crosses to the loop through a seqlock.
+// the IMU sensor's ring; its health crosses to the loop through a SeqLatch.
 #include <atomic>
 #include <memory>
 #include <string>
 
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "drivers/imu/mpu_imu.hpp"
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/device_buses.hpp"
@@ -58,7 +58,7 @@ class ImuDevice final : public Device {
   est::SensorSample sample_;
   drivers::ImuMeasurement measurement_;
   Health scratch_;
-  SeqLock<Health> health_;
+  SeqLatch<Health> health_;
   std::atomic<std::int64_t> samples_{0};
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 };

@@ -8,7 +8,7 @@
 //                  behind, capture never waits.
 //   loop thread    fill_snapshot(): the tick's estimate (world -> base_link
 //                  and its stamp) into an SPSC ring; the mapper's health
-//                  out of a seqlock into its diagnostics slot.
+//                  out of a SeqLatch into its diagnostics slot.
 //   mapper thread  step(): the loop's poses into a PoseHistory; each queued
 //                  keyframe, once the loop is pose_delay past its stamp,
 //                  placed with the pose at its stamp as the loop had it
@@ -34,7 +34,7 @@
 #include <string>
 
 #include "core/frame_pool.hpp"
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "core/spsc_ring.hpp"
 #include "core/triple_buffer.hpp"
 #include "geometry/pose_history.hpp"
@@ -187,7 +187,7 @@ class MapperDevice final : public Device, public FrameConsumer, public GridSourc
   std::unique_ptr<mapping::ProjectedGrid> grid_;  // likewise
   std::unique_ptr<std::int8_t[]> final_cells_;
   MapperStats stats_;
-  SeqLock<MapperStats> health_;
+  SeqLatch<MapperStats> health_;
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 
   static constexpr int kMaxGridConsumers = 2;

@@ -35,7 +35,7 @@
 #include <memory>
 #include <string>
 
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "core/spsc_ring.hpp"
 #include "core/triple_buffer.hpp"
 #include "navigation/command_gate.hpp"
@@ -230,7 +230,7 @@ class NavigatorDevice final : public Device, public GridConsumer {
   std::unique_ptr<navigation::GridCell[]> smoothed_;  // workspace of the smoothing
   int path_size_ = 0;
   navigator_detail::NavStats stats_;
-  SeqLock<navigator_detail::NavStats> health_;
+  SeqLatch<navigator_detail::NavStats> health_;
   TripleBuffer<navigator_detail::PathForDisplay> display_;
 
   // Loop thread.

@@ -2,12 +2,12 @@
 // The stereo visual odometry as a frame consumer of the camera: on the
 // camera's thread, each newest pair (after the first) becomes the left eye's
 // twist, pushed into the stereo_vo sensor's ring (visual_odometry.hpp); its
-// health crosses to the loop through a seqlock.
+// health crosses to the loop through a SeqLatch.
 #include <atomic>
 #include <memory>
 #include <string>
 
-#include "core/seqlock.hpp"
+#include "core/seq_cell.hpp"
 #include "runtime/devices/frame_consumer.hpp"
 #include "runtime/devices/device.hpp"
 #include "runtime/devices/visual_odometry/visual_odometry.hpp"
@@ -46,7 +46,7 @@ class VisualOdometryDevice final : public Device, public FrameConsumer {
   std::unique_ptr<VisualOdometry> vo_;
   std::uint64_t last_frame_ = 0;  // the last frame id the odometry took
   est::SensorSample sample_;
-  SeqLock<VoStats> health_;
+  SeqLatch<VoStats> health_;
   std::atomic<std::int64_t> samples_{0};
   static_assert(std::atomic<std::int64_t>::is_always_lock_free);
 };
