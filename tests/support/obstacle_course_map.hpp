@@ -48,6 +48,10 @@ struct CourseMappingSettings {
   // pixel the matcher estimated, in place of its estimate: the map with
   // the stereo's error taken out.
   bool true_disparity = false;
+  // Otherwise, when positive: an oracle that keeps only the matcher's
+  // estimates within this many matched pixels of the truth, to show how
+  // good the depth would have to be.
+  double keep_within_px = 0.0;
 };
 
 class ObstacleCourseMapping {
@@ -151,7 +155,7 @@ class ObstacleCourseMapping {
       }
       const int downscale = disparity_params().downscale;
       texture_.apply(vision::view_of(left), downscale, vision::view_of(disparity));
-      if (settings_.true_disparity) replace_with_truth(world_T_camera, &disparity);
+      if (settings_.true_disparity || settings_.keep_within_px > 0.0) apply_truth(world_T_camera, &disparity);
       geometry::RigidTransform map_T_camera = world_T_camera;
       map_T_camera.translation += settings_.map_offset;
       const mapping::DisparityPointCounts c = mapping::disparity_points(
@@ -165,8 +169,10 @@ class ObstacleCourseMapping {
   }
 
  private:
-  void replace_with_truth(const geometry::RigidTransform& world_T_camera, vision::Plane<std::uint16_t>* disparity) {
+  void apply_truth(const geometry::RigidTransform& world_T_camera, vision::Plane<std::uint16_t>* disparity) {
     const int downscale = disparity_params().downscale;
+    // Matched pixels in the disparity's fixed point (input pixels).
+    const double tolerance = settings_.keep_within_px * downscale * vision::kDisparityScale;
     for (int v = 0; v < disparity->height(); ++v) {
       for (int u = 0; u < disparity->width(); ++u) {
         std::uint16_t& d = disparity->row(v)[u];
@@ -174,7 +180,11 @@ class ObstacleCourseMapping {
         const double z = true_depth(*world_, world_T_camera, kF, kCx, kCy, downscale * u + 0.5 * (downscale - 1),
                                     downscale * v + 0.5 * (downscale - 1));
         const double raw = std::isfinite(z) ? std::round(kF * kBaseline * vision::kDisparityScale / z) : 0.0;
-        d = raw < vision::kInvalidDisparity ? static_cast<std::uint16_t>(raw) : vision::kInvalidDisparity;
+        if (!settings_.true_disparity) {
+          if (std::abs(d - raw) > tolerance) d = vision::kInvalidDisparity;
+        } else {
+          d = raw < vision::kInvalidDisparity ? static_cast<std::uint16_t>(raw) : vision::kInvalidDisparity;
+        }
       }
     }
   }

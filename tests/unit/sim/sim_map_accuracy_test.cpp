@@ -8,7 +8,7 @@
 // The map's frame lies half a cell off the world's, as a robot's map has
 // no reason to start on its walls' lines; on them, a point on a face that
 // looks toward +x or +y belongs to the voxel outside it, and the renderer's
-// true depth put 32 % of the occupied cells in free space.
+// true disparity put 28 % of the occupied cells in free space.
 //
 // The issue's first target, "at least 95 % of the true obstacle cells the
 // camera saw are occupied", is scored as it reads: the cells of the drive
@@ -34,7 +34,9 @@
 // seldom repeats. "Seen" is within each one's range. And a third time with
 // the renderer's true disparity in place of the matcher's: both targets
 // hold, so the scoring and the path from disparity to grid are right, and
-// the matcher's depth is what misses the second.
+// the matcher's depth is what misses the second; and with an oracle that
+// keeps only estimates near the truth, to show how near they would have
+// to be.
 #include <gtest/gtest.h>
 
 #include <cmath>
@@ -150,7 +152,7 @@ void score_course(double every_s, const CourseMappingSettings& settings, Score* 
       seen_occupied += cell_at(i, j) == mapping::kCellOccupied;
     }
   }
-  ASSERT_GT(cells_seen, 200);  // the course's obstacles were in view
+  ASSERT_GT(cells_seen, 50);  // the course's obstacles were in view (106 within 2 m)
   const double seen_recall = static_cast<double>(seen_occupied) / cells_seen;
   std::printf("%d obstacle cells the camera saw: %.1f %% occupied (the issue: at least 95 %%)\n", cells_seen,
               100.0 * seen_recall);
@@ -178,7 +180,7 @@ void score_course(double every_s, const CourseMappingSettings& settings, Score* 
       }
     }
   }
-  ASSERT_GT(solid_seen, 1000);  // the course's obstacles were seen
+  ASSERT_GT(solid_seen, 100);  // the course's obstacles were seen (193 within 2 m)
   ASSERT_GT(occupied, 0);
   const double recall = static_cast<double>(solid_occupied) / solid_seen;
   const double recall_near = static_cast<double>(solid_occupied_near) / solid_seen;
@@ -229,6 +231,37 @@ TEST(SimMapAccuracy, TheTrueDisparityMeetsBothTargets) {
   // what misses the second is the matcher's depth.
   EXPECT_GE(s.seen_recall, 0.95);
   EXPECT_LE(s.false_share, 0.02);
+
+  // On the world's own voxel lines the same perfect depth fails both: a
+  // point on a face that looks toward +x or +y belongs to the voxel outside
+  // it (today 84 % and 28 %). Why the map lies half a cell off.
+  truth.map_offset = Eigen::Vector3d::Zero();
+  ASSERT_NO_FATAL_FAILURE(score_course(2.0, truth, &s));
+  EXPECT_LT(s.seen_recall, 0.95);
+  EXPECT_GT(s.false_share, 0.2);
+}
+
+// How good the depth would have to be: only the matcher's estimates
+// within a tolerance of the true disparity kept (an oracle no matcher
+// has), and the matcher's at a 2 m range. Today 51.5, 50.0, 43.6 and
+// 31.3 % of the occupied cells free in truth within 1, 0.5, 0.25 and
+// 0.1 matched px, 35.1 % at 2 m: none near the issue's 2 %, which the
+// true disparity (1/32 px in the matcher's fixed point) meets. At 6 m a
+// matched pixel is 1.7 m of depth.
+TEST(SimMapAccuracy, DepthGoodToATenthOfAPixelStillMissesThePrecisionTarget) {
+  for (const double px : {1.0, 0.5, 0.25, 0.1}) {
+    SCOPED_TRACE(px);
+    CourseMappingSettings oracle = settings(0.5, ObstacleCourseMapping::kRange);
+    oracle.keep_within_px = px;
+    std::printf("the matcher's estimates within %.2f px of the truth:\n", px);
+    Score s;
+    ASSERT_NO_FATAL_FAILURE(score_course(2.0, oracle, &s));
+    EXPECT_GT(s.false_share, 0.2);
+  }
+  std::printf("the matcher's at a 2 m range:\n");
+  Score s;
+  ASSERT_NO_FATAL_FAILURE(score_course(2.0, settings(0.5, 2.0), &s));
+  EXPECT_GT(s.false_share, 0.2);
 }
 
 }  // namespace sim_map_accuracy_test
