@@ -60,7 +60,7 @@ case "$kind" in
     # and the estimate's steadiness; the refusal runs here in the odometry's
     # unit tests (dark and flashed pairs), the drive's path (render, match,
     # fuse, record, replay) in the camera's lockstep drives. And the map's accuracy on
-    # the obstacle course (both scorings; 50 s and minutes here): it scores depth and map against the
+    # the obstacle course (every scoring; minutes here): it scores depth and map against the
     # world's truth; its renderer, matcher and map run here in the rendered
     # pairs' tests and the mapper's lockstep drive. And the navigator's
     # closed loop (30 s natively, minutes here) and its whole obstacle

@@ -90,11 +90,11 @@ cd "$dir"
 #   odometry waits for it), not about the instruction set; it runs natively
 #   and under ASan, and the odometry's arithmetic on aarch64 is the cross-
 #   architecture replay's.
-# - the map's accuracy on the simulated obstacle course (35 and 345
-#   rendered pairs, their disparity and the map: seconds natively, minutes
-#   emulated): it
-#   scores depth against the world's truth; the matcher's and the map's
-#   bits on aarch64 are their own unit tests' (backends agree, digests).
+# - the map's accuracy on the simulated obstacle course (35 to 345
+#   rendered pairs a scoring, their disparity and the map: seconds
+#   natively, minutes emulated): it scores depth against the world's
+#   truth; the matcher's and the map's bits on aarch64 are their own unit
+#   tests' (backends agree, digests).
 # - the mapper's lockstep drive and its replay (rendering and keyframes: a
 #   minute or more emulated): the map on aarch64 is the cross-architecture
 #   replay's, which compares its digest with the x86-64 one.

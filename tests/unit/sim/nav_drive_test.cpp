@@ -99,8 +99,9 @@ TEST(NavDrive, FindsTheWallInItsOwnMapGoesRoundAndItsRecordingReplays) {
 
 // The closed loop: the whole obstacle course as config/sim_nav.toml
 // drives it, ten goals in turn from an empty map, each reached within 0.3 m
-// of the truth, never nearer an obstacle than the footprint's radius. The scenario's 240 s are
-// cut to 180: its last goal is reached after some 160 s. That the closed
+// of the truth, never nearer an obstacle than the footprint's radius. The
+// scenario's 240 s are cut to 180: its last goal is reached after some
+// 160 s. That the closed
 // loop's recording replays is the test above's (this drive's is 7 GB).
 TEST(NavDrive, TheObstacleCoursesTenGoalsEachReachedWithin30CmOfTheTruth) {
   std::string scenario = read_file(std::string(RTFUSE_SOURCE_DIR) + "/config/scenarios/obstacle_goals.toml");
